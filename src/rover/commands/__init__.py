@@ -1,0 +1,1 @@
+"""One module per `rover` command; each exposes `register(app)`."""

@@ -1,0 +1,1 @@
+"""Reading and writing videos, frame folders, dataset directories and robot datasets."""

@@ -1,0 +1,119 @@
+"""The Trace: everything a method did on one episode, enough to redraw its figures.
+
+Written as JSON by `rover reason` and by the evaluation runner (one file per episode and
+method). Progress values are on 0..100 over the full task; frames are keyed by their
+original frame index so traces of differently subsampled runs compare correctly.
+"""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, Field
+
+TRACE_SCHEMA_VERSION = 1
+
+
+class FrameRecord(BaseModel):
+    index: int  # original frame index
+    position: int  # position among the sampled frames the method saw
+    progress: float | None = None  # 0..100 over the full task (stitched, filled forward)
+    description: str | None = None
+    subtask_path: list[str] = Field(default_factory=list)  # root task excluded
+    subtask_progress: float | None = None  # raw value the model gave for its line
+    predicted: bool = False  # False when progress was filled forward, not answered
+
+
+class CallRecord(BaseModel):
+    id: int
+    kind: str  # PromptMeta.kind
+    frame_indices: list[int] = Field(default_factory=list)  # images sent, in order
+    line_id: int | None = None  # ROVER: which line of reasoning made the call
+    subtask_path: list[str] = Field(default_factory=list)
+    prompt_tokens: int = 0
+    completion_tokens: int = 0
+    image_tokens: int = 0
+    usage_source: Literal["reported", "estimated"] = "estimated"
+    latency_s: float = 0.0
+    cached: bool = False
+    parse: Literal["ok", "retried", "failed"] = "ok"
+    response: str = ""
+    error: str | None = None
+
+
+class LineNode(BaseModel):
+    """One line of reasoning (ROVER): its subtask, its frames and its children."""
+
+    id: int
+    subtask: str
+    depth: int
+    first_frame: int  # original index of the line's first frame (its "initial robot scene")
+    last_frame: int | None = None
+    outcome: Literal["complete", "end_of_video", "guard", "failed", "running"] = "running"
+    final_description: str | None = None
+    children: list[LineNode] = Field(default_factory=list)
+
+
+class Totals(BaseModel):
+    calls: int = 0
+    cached_calls: int = 0
+    prompt_tokens: int = 0
+    completion_tokens: int = 0
+    image_tokens: int = 0
+    total_tokens: int = 0
+    latency_s: float = 0.0
+    parse_failures: int = 0
+    parse_retries: int = 0
+
+
+class Trace(BaseModel):
+    schema_version: int = TRACE_SCHEMA_VERSION
+    method: str
+    params: dict[str, Any] = Field(default_factory=dict)
+    backend: str
+    model: str
+    oracle: bool = False  # True when answers came from ground truth, not a VLM
+    episode_id: str
+    task: str
+    view: str | None = None
+    num_frames: int
+    frame_indices: list[int]
+    frames: list[FrameRecord]
+    tree: LineNode | None = None
+    calls: list[CallRecord] = Field(default_factory=list)
+    totals: Totals = Field(default_factory=Totals)
+    started_at: str = Field(default_factory=lambda: datetime.now(UTC).isoformat())
+    finished_at: str | None = None
+    error: str | None = None
+
+    def progress(self) -> list[float]:
+        """Full-task progress per sampled frame (0..100), None replaced by 0."""
+        return [f.progress if f.progress is not None else 0.0 for f in self.frames]
+
+    def compute_totals(self) -> Totals:
+        t = Totals()
+        for c in self.calls:
+            t.calls += 1
+            t.cached_calls += int(c.cached)
+            t.prompt_tokens += c.prompt_tokens
+            t.completion_tokens += c.completion_tokens
+            t.image_tokens += c.image_tokens
+            t.latency_s += c.latency_s
+            t.parse_failures += int(c.parse == "failed")
+            t.parse_retries += int(c.parse == "retried")
+        t.total_tokens = t.prompt_tokens + t.completion_tokens
+        return t
+
+    def save(self, path: Path) -> None:
+        """Write atomically: a reader never sees half a trace."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(self.model_dump_json(indent=1))
+        tmp.replace(path)
+
+    @classmethod
+    def load(cls, path: Path) -> Trace:
+        return cls.model_validate_json(Path(path).read_text())

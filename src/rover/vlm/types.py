@@ -1,0 +1,191 @@
+"""The VLM interface every method talks through: prompts in, completions out.
+
+Content parts are small pydantic models told apart by `type`, so a prompt is plain data:
+hashable for the cache, serialisable for cassettes and traces, convertible by each
+backend into its SDK's format and nothing else.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Protocol, runtime_checkable
+
+import numpy as np
+from PIL import Image
+from pydantic import BaseModel, ConfigDict, Field
+
+if TYPE_CHECKING:
+    from rover.episode import Episode
+
+
+class ImageEncoding(BaseModel):
+    """How images are turned into bytes before they are sent."""
+
+    format: Literal["JPEG", "PNG"] = "JPEG"
+    quality: int = 90
+    max_side: int | None = None  # downscale so the long side is at most this (never upscale)
+
+
+_ENCODED: dict[tuple[str, str], EncodedImage] = {}
+_ENCODED_MAX = 4096
+
+
+class EncodedImage(BaseModel):
+    """An image as the bytes a provider receives, with its content hash and size."""
+
+    model_config = ConfigDict(frozen=True)
+
+    data: bytes = Field(repr=False)
+    mime: str
+    width: int
+    height: int
+    sha256: str
+
+    @classmethod
+    def from_any(
+        cls, image: Image.Image | np.ndarray | str | Path | bytes, enc: ImageEncoding | None = None
+    ) -> EncodedImage:
+        """Encode once: identical pixels with identical settings come back from a memo."""
+        enc = enc or ImageEncoding()
+        if isinstance(image, str | Path):
+            image = Image.open(image)
+        elif isinstance(image, bytes):
+            image = Image.open(io.BytesIO(image))
+        if isinstance(image, np.ndarray):
+            arr = np.ascontiguousarray(image)
+            if arr.dtype != np.uint8:
+                raise ValueError(f"image arrays must be uint8, got {arr.dtype}")
+            pixel_key = hashlib.sha256(arr.tobytes() + str(arr.shape).encode()).hexdigest()
+        else:
+            arr = None
+            image = image.convert("RGB")
+            pixel_key = hashlib.sha256(image.tobytes() + str(image.size).encode()).hexdigest()
+        memo_key = (pixel_key, enc.model_dump_json())
+        hit = _ENCODED.get(memo_key)
+        if hit is not None:
+            return hit
+        pil = Image.fromarray(arr) if arr is not None else image
+        if enc.max_side and max(pil.size) > enc.max_side:
+            s = enc.max_side / max(pil.size)
+            pil = pil.resize((max(1, round(pil.width * s)), max(1, round(pil.height * s))))
+        buf = io.BytesIO()
+        if enc.format == "JPEG":
+            pil.save(buf, format="JPEG", quality=enc.quality)
+        else:
+            pil.save(buf, format="PNG")
+        data = buf.getvalue()
+        out = cls(
+            data=data,
+            mime=f"image/{enc.format.lower()}",
+            width=pil.width,
+            height=pil.height,
+            sha256=hashlib.sha256(data).hexdigest(),
+        )
+        if len(_ENCODED) >= _ENCODED_MAX:
+            _ENCODED.clear()
+        _ENCODED[memo_key] = out
+        return out
+
+
+class TextPart(BaseModel):
+    type: Literal["text"] = "text"
+    text: str
+
+
+class ImagePart(BaseModel):
+    type: Literal["image"] = "image"
+    image: EncodedImage
+    frame_index: int | None = None  # original frame index, for traces
+    detail: Literal["auto", "low", "high"] | None = None  # OpenAI detail; None = backend default
+
+
+Part = Annotated[TextPart | ImagePart, Field(discriminator="type")]
+
+
+class Message(BaseModel):
+    role: Literal["system", "user", "assistant"]
+    content: str | list[Part]
+
+    def parts(self) -> list[TextPart | ImagePart]:
+        return [TextPart(text=self.content)] if isinstance(self.content, str) else self.content
+
+
+class PromptMeta(BaseModel):
+    """What the caller is asking; real backends ignore it, traces and the oracle read it.
+
+    `kind` names the question (see `rover.methods` for the vocabulary, e.g. "rover.step",
+    "gvl.batch", "concat.frame", "judge.frame", "qa.answer"); `frame_indices` are the
+    original indices of the frames shown, in the order shown; `subtask` is the line of
+    reasoning's current (sub)task text and `subtask_path` the chain from the root task.
+    """
+
+    kind: str
+    frame_indices: list[int] = Field(default_factory=list)
+    positions: list[int] = Field(default_factory=list)  # sampled positions of those frames
+    subtask: str | None = None
+    subtask_path: list[str] = Field(default_factory=list)
+    extra: dict[str, Any] = Field(default_factory=dict)
+
+
+class Prompt(BaseModel):
+    messages: list[Message]
+    meta: PromptMeta
+
+    def images(self) -> list[ImagePart]:
+        return [p for m in self.messages for p in m.parts() if isinstance(p, ImagePart)]
+
+    def fingerprint(self) -> str:
+        """Hash of what a provider sees (roles, text, image hashes), never of meta."""
+        h = hashlib.sha256()
+        for m in self.messages:
+            h.update(b"\x00role:" + m.role.encode())
+            for p in m.parts():
+                if isinstance(p, TextPart):
+                    h.update(b"\x00text:" + p.text.encode())
+                else:
+                    h.update(f"\x00image:{p.image.sha256}:{p.detail}".encode())
+        return h.hexdigest()
+
+
+class SamplingParams(BaseModel):
+    temperature: float = 0.0
+    max_tokens: int = 512
+    seed: int | None = 0
+
+
+class Usage(BaseModel):
+    prompt_tokens: int = 0
+    completion_tokens: int = 0
+    image_tokens: int = 0  # part of prompt_tokens, when known
+    source: Literal["reported", "estimated"] = "estimated"
+
+    @property
+    def total_tokens(self) -> int:
+        return self.prompt_tokens + self.completion_tokens
+
+
+class Completion(BaseModel):
+    text: str
+    usage: Usage = Field(default_factory=Usage)
+    latency_s: float = 0.0
+    cached: bool = False
+    backend: str = ""
+    model: str = ""
+
+
+@runtime_checkable
+class VLM(Protocol):
+    """What methods need from a backend: one async call, plus per-episode binding."""
+
+    backend: str  # "openai", "gemini", "hf", "oracle", "replay"
+    model: str
+
+    async def complete(self, prompt: Prompt, params: SamplingParams | None = None) -> Completion:
+        """Answer one prompt (retries, cache, concurrency limits already applied)."""
+        ...
+
+    def bind(self, episode: Episode) -> VLM:
+        """The VLM to use for this episode (the oracle reads its ground truth; others: self)."""
+        ...
