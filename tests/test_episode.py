@@ -39,3 +39,40 @@ def test_dataset_round_trip(tmp_path, make_episode):
 def test_missing_dataset_is_one_line_error(tmp_path):
     with pytest.raises(InputError, match="not a rover dataset"):
         load_dataset(tmp_path)
+
+
+def test_resized_keeps_aspect_and_never_upscales(make_episode):
+    ep = make_episode(n=4, size=32)
+    assert ep.resized(16).views["left"].shape == (4, 16, 16, 3)
+    assert ep.resized(64).views["left"].shape == (4, 32, 32, 3)
+    assert ep.resized(None) is ep
+
+
+def test_select_and_view_validation(make_episode):
+    ep = make_episode(n=6)
+    with pytest.raises(InputError):
+        ep.select([])
+    with pytest.raises(ValueError):
+        ep.select([3, 1])
+    with pytest.raises(InputError, match="no view 'top'"):
+        ep.with_view("top")
+    assert ep.subsample(None) is ep and ep.subsample(10) is ep
+
+
+def test_metadata_round_trips_without_pixels(make_episode):
+    from rover.episode import Episode
+
+    ep = make_episode(n=5)
+    again = Episode.model_validate_json(ep.model_dump_json())
+    assert again.truth == ep.truth and again.frame_indices == ep.frame_indices
+    assert again.views == {}
+
+
+def test_inconsistent_episodes_are_rejected(make_episode):
+    from pydantic import ValidationError
+
+    ep = make_episode(n=5)
+    with pytest.raises(ValidationError, match="strictly increasing"):
+        ep.model_validate({**ep.model_dump(), "frame_indices": [0, 2, 2, 3, 4]})
+    with pytest.raises(ValidationError, match="progress values"):
+        ep.model_validate({**ep.model_dump(), "frame_indices": [0, 1, 2]})

@@ -66,8 +66,9 @@ def episode_ids(root: Path) -> list[str]:
     if not ep_dir.is_dir():
         return []
     return sorted(
-        p.name for p in ep_dir.iterdir() if p.is_dir() and (p / EPISODE_FILE).exists()
-        and not p.name.endswith(".part")
+        p.name
+        for p in ep_dir.iterdir()
+        if p.is_dir() and (p / EPISODE_FILE).exists() and not p.name.endswith(".part")
     )
 
 

@@ -53,12 +53,16 @@ def probe_video(path: Path) -> tuple[int, float]:
 def read_video(path: Path, positions: list[int] | None = None) -> np.ndarray:
     """Decode a video to (T, H, W, 3) uint8 RGB; only the given frame positions if set.
 
-    Decodes sequentially and keeps the wanted frames: right for the short clips rover
-    works with; `rover.io.seek` handles long videos where seeking pays off.
+    With `positions`, seeks to the keyframe before each wanted frame when that skips
+    work (`rover.io.seek`), frame-exact with a full decode; without, decodes sequentially.
     """
     path = Path(path)
     if not path.exists():
         raise InputError(f"{path}: no such video file")
+    if positions is not None and len(positions) > 0:
+        from rover.io.seek import decode_frames
+
+        return decode_frames(path, sorted(set(positions)))
     wanted = None if positions is None else set(positions)
     last = None if positions is None else max(positions)
     out: list[np.ndarray] = []

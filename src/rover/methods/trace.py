@@ -54,6 +54,10 @@ class LineNode(BaseModel):
     outcome: Literal["complete", "end_of_video", "guard", "failed", "running"] = "running"
     final_description: str | None = None
     children: list[LineNode] = Field(default_factory=list)
+    first_position: int = 0  # sampled position of first_frame
+    last_position: int | None = None
+    planned_subtasks: list[str] = Field(default_factory=list)  # plan the model announced, if any
+    calls: int = 0  # VLM calls this line made itself (children excluded)
 
 
 class Totals(BaseModel):

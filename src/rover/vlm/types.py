@@ -16,6 +16,8 @@ import numpy as np
 from PIL import Image
 from pydantic import BaseModel, ConfigDict, Field
 
+from rover.errors import InputError
+
 if TYPE_CHECKING:
     from rover.episode import Episode
 
@@ -35,7 +37,8 @@ _ENCODED_MAX = 4096
 class EncodedImage(BaseModel):
     """An image as the bytes a provider receives, with its content hash and size."""
 
-    model_config = ConfigDict(frozen=True)
+    # base64 in JSON: encoded images are binary, and traces/cassettes must stay valid JSON
+    model_config = ConfigDict(frozen=True, ser_json_bytes="base64", val_json_bytes="base64")
 
     data: bytes = Field(repr=False)
     mime: str
@@ -50,6 +53,8 @@ class EncodedImage(BaseModel):
         """Encode once: identical pixels with identical settings come back from a memo."""
         enc = enc or ImageEncoding()
         if isinstance(image, str | Path):
+            if not Path(image).is_file():
+                raise InputError(f"image file not found: {image}")
             image = Image.open(image)
         elif isinstance(image, bytes):
             image = Image.open(io.BytesIO(image))
@@ -67,6 +72,8 @@ class EncodedImage(BaseModel):
         if hit is not None:
             return hit
         pil = Image.fromarray(arr) if arr is not None else image
+        if pil.mode not in ("RGB", "L"):
+            pil = pil.convert("RGB")  # JPEG has no alpha channel
         if enc.max_side and max(pil.size) > enc.max_side:
             s = enc.max_side / max(pil.size)
             pil = pil.resize((max(1, round(pil.width * s)), max(1, round(pil.height * s))))
@@ -99,6 +106,26 @@ class ImagePart(BaseModel):
     image: EncodedImage
     frame_index: int | None = None  # original frame index, for traces
     detail: Literal["auto", "low", "high"] | None = None  # OpenAI detail; None = backend default
+
+    @classmethod
+    def from_image(
+        cls,
+        image: Image.Image | np.ndarray | str | Path | bytes,
+        *,
+        frame_index: int | None = None,
+        detail: Literal["auto", "low", "high"] | None = None,
+        encoding: ImageEncoding | None = None,
+    ) -> ImagePart:
+        """Encode (once, memoised by pixel hash) and wrap an image for a prompt.
+
+        Pass the backend's `vlm.image_encoding` as `encoding` so the bytes sent follow the
+        user's `--image-format/--image-quality/--image-max-side` choices.
+        """
+        return cls(
+            image=EncodedImage.from_any(image, encoding),
+            frame_index=frame_index,
+            detail=detail,
+        )
 
 
 Part = Annotated[TextPart | ImagePart, Field(discriminator="type")]
@@ -135,6 +162,10 @@ class Prompt(BaseModel):
 
     def images(self) -> list[ImagePart]:
         return [p for m in self.messages for p in m.parts() if isinstance(p, ImagePart)]
+
+    def describe(self) -> str:
+        """A short label for error messages: what was asked and which frames were shown."""
+        return f"kind={self.meta.kind} frames={self.meta.frame_indices}"
 
     def fingerprint(self) -> str:
         """Hash of what a provider sees (roles, text, image hashes), never of meta."""

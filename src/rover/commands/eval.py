@@ -1,0 +1,218 @@
+"""`rover eval`: run methods over a dataset, score them, write paper-style tables."""
+
+from __future__ import annotations
+
+import asyncio
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from rover.errors import InputError
+from rover.vlm import cli_options as vo
+
+HELP = "Evaluate reasoning methods on a dataset: progress, frame reasoning, video QA, cost."
+
+
+def register(app: typer.Typer) -> None:
+    app.command("eval", help=HELP)(eval_command)
+
+
+def eval_command(
+    out: Annotated[Path, typer.Option("--out", help="Run directory to write (RUN_DIR).")],
+    dataset: Annotated[
+        Path | None, typer.Option("--dataset", help="A rover dataset directory.")
+    ] = None,
+    source: Annotated[
+        str | None,
+        typer.Option(
+            "--source",
+            help="Instead of --dataset: source spec(s), comma-separated "
+            "(lerobot:PATH, rlds:PATH, hdf5:PATH, a video folder...)",
+        ),
+    ] = None,
+    methods: Annotated[
+        str, typer.Option("--methods", help="Comma-separated method names.")
+    ] = "rover,gvl,temporal-concat,local-concat",
+    backend: Annotated[
+        str, typer.Option("--backend", help="VLM spec(s), comma-separated: " + vo.VLM_HELP)
+    ] = "oracle",
+    judge: Annotated[
+        str, typer.Option("--judge", help="Task 2 judge: 'rule', a VLM spec, or 'none'.")
+    ] = "rule",
+    answerer: Annotated[
+        str, typer.Option("--answerer", help="Task 3 QA answerer: 'rule', a VLM spec, or 'none'.")
+    ] = "rule",
+    concurrency: Annotated[
+        int, typer.Option("--concurrency", help="Episodes in flight at once.")
+    ] = 16,
+    calls_in_flight: Annotated[
+        int | None,
+        typer.Option(
+            "--calls-in-flight", help="VLM calls in flight per backend (default: --concurrency)."
+        ),
+    ] = None,
+    limit: Annotated[int | None, typer.Option("--limit", help="Only the first N episodes.")] = None,
+    episodes: Annotated[
+        int | None,
+        typer.Option(
+            "--episodes", help="Sample N episodes per dataset/source (reproducible with --seed)."
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed for --episodes sampling.")] = 0,
+    frames: Annotated[
+        str | None,
+        typer.Option("--frames", help="Frames per video, comma-separated sweep (default: all)."),
+    ] = None,
+    window: Annotated[
+        str | None,
+        typer.Option("--window", help="ROVER window sizes, comma-separated sweep (default: 3)."),
+    ] = None,
+    views: Annotated[
+        str | None,
+        typer.Option(
+            "--views", help="Camera views, comma-separated sweep (default: episode's own)."
+        ),
+    ] = None,
+    resume: Annotated[bool, typer.Option("--resume", help="Continue an interrupted run.")] = False,
+    report: Annotated[
+        bool, typer.Option("--report", help="Build the HTML report at the end.")
+    ] = False,
+    flip_prob: Annotated[
+        float | None,
+        typer.Option(
+            "--flip-prob", help="Oracle noise: probability of flipping each described fact."
+        ),
+    ] = None,
+    jitter: Annotated[
+        float | None,
+        typer.Option(
+            "--jitter", help="Oracle noise: std. dev. of progress noise (percentage points)."
+        ),
+    ] = None,
+    oracle_seed: Annotated[
+        int | None, typer.Option("--oracle-seed", help="Oracle noise seed.")
+    ] = None,
+    cache: vo.CacheOpt = None,
+    no_cache: vo.NoCacheOpt = False,
+    record: vo.RecordOpt = None,
+    timeout: vo.TimeoutOpt = None,
+    max_retries: vo.MaxRetriesOpt = None,
+    api_key_env: vo.ApiKeyEnvOpt = None,
+    detail: vo.DetailOpt = None,
+    token_rule: vo.TokenRuleOpt = None,
+    max_side: vo.ImageMaxSideOpt = None,
+    temperature: vo.TemperatureOpt = None,
+    max_tokens: vo.MaxTokensOpt = None,
+    device: vo.DeviceOpt = None,
+) -> None:
+    """Evaluate reasoning methods on a dataset: progress, frame reasoning, video QA, cost."""
+    from rover.eval.runner import EvalOptions, finish_run, prepare_run
+    from rover.eval.variants import parse_int_list, parse_name_list, split_backend_specs
+
+    if concurrency < 1:
+        raise InputError(f"--concurrency must be at least 1, got {concurrency}")
+    config = vo.config_from_options(
+        cache=cache,
+        no_cache=no_cache,
+        record=record,
+        timeout=timeout,
+        max_retries=max_retries,
+        api_key_env=api_key_env,
+        detail=detail,
+        token_rule=token_rule,
+        max_side=max_side,
+        temperature=temperature,
+        max_tokens=max_tokens,
+        device=device,
+        concurrency=calls_in_flight or concurrency,
+        flip_prob=flip_prob,
+        jitter=jitter,
+        seed=oracle_seed,
+    )
+    if dataset is not None and source is not None:
+        raise InputError("give either --dataset or --source, not both")
+    if dataset is None and source is None:
+        raise InputError("give the data to evaluate: --dataset DIR or --source SPEC")
+    opts = EvalOptions(
+        dataset=dataset,
+        sources=parse_name_list(source, "--source") if source else [],
+        methods=parse_name_list(methods, "--methods"),
+        backends=split_backend_specs(backend),
+        judge=judge.strip(),
+        answerer=answerer.strip(),
+        frames=parse_int_list(frames, "--frames", minimum=2),
+        windows=parse_int_list(window, "--window", minimum=2),
+        views=[v for v in parse_name_list(views, "--views")] if views else [None],
+        concurrency=concurrency,
+        limit=limit,
+        episodes=episodes,
+        seed=seed,
+        out=out,
+        resume=resume,
+        backend_config=config,
+        command=["rover"] + sys.argv[1:],
+    )
+    err = Console(stderr=True, highlight=False)
+    progress = Progress(
+        TextColumn("[bold]eval[/]"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("episodes"),
+        TextColumn("{task.fields[info]}"),
+        TimeElapsedColumn(),
+        console=err,
+        transient=False,
+    )
+    task_id = progress.add_task("eval", total=None, info="")
+
+    def on_update(state) -> None:
+        info = (
+            f"units {state.units_done}/{state.units_total}  calls {state.calls:,}  "
+            f"tokens {state.tokens:,}  errors {state.errors}"
+        )
+        progress.update(
+            task_id, total=state.episodes_total, completed=state.episodes_done, info=info
+        )
+
+    runner = prepare_run(opts, on_update)
+    with progress:
+        state, metrics = asyncio.run(finish_run(runner))
+    _print_main_table(metrics)
+    out_console = Console(highlight=False)
+    out_console.print(f"run directory: {out}  (metrics.json, summary.md)")
+    if state.errors:
+        err.print(
+            f"[yellow]{state.errors} work unit(s) failed[/]; see {out / 'errors.jsonl'} "
+            "(rerun with --resume to retry them)"
+        )
+    if report:
+        _build_report(out, err)
+    if metrics["counts"]["traces"] == 0:
+        raise typer.Exit(1)
+
+
+def _print_main_table(metrics: dict) -> None:
+    from rover.eval.summary import main_rows
+
+    headers, rows = main_rows(metrics, compact=True)
+    table = Table(title="rover eval: mean over videos (± SE in summary.md)")
+    for h in headers:
+        table.add_column(h, overflow="fold")
+    for r in rows:
+        table.add_row(*r)
+    Console().print(table)
+
+
+def _build_report(run_dir: Path, err: Console) -> None:
+    try:
+        from rover.report import build_report
+    except ImportError:
+        err.print("the report builder is not available in this build; skipped --report")
+        return
+    path = build_report(run_dir)
+    Console(highlight=False).print(f"report: {path}")

@@ -1,0 +1,37 @@
+"""`rover report RUN_DIR`: figures and a static HTML page for an evaluation run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+
+def register(app: typer.Typer) -> None:
+    app.command("report")(report)
+
+
+def report(
+    run_dir: Annotated[Path, typer.Argument(help="Run directory written by `rover eval`.")],
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help="Where to write the report (default: RUN_DIR/report)."),
+    ] = None,
+    dataset: Annotated[
+        Path | None,
+        typer.Option("--dataset", help="Dataset directory of the run, if run.json lacks it."),
+    ] = None,
+    max_episodes: Annotated[
+        int, typer.Option("--max-episodes", min=0, help="Episodes shown in the viewer.")
+    ] = 40,
+) -> None:
+    """Draw the paper's figures (PNG + SVG) and write one HTML page with an episode viewer."""
+    from rover.report import build_report
+
+    console = Console(highlight=False)
+    with console.status("building report"):
+        index = build_report(run_dir, out, dataset=dataset, max_episodes=max_episodes)
+    console.print(f"report: {index}")
+    console.print(f"open it: {index.resolve().as_uri()}")

@@ -1,0 +1,51 @@
+"""Inference cost (App. G): tokens and VLM calls per video, by method and frame count."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rover.eval.aggregate import finite_or_none, group_mean_se
+from rover.methods.trace import Totals, Trace
+
+
+def trace_totals(trace: Trace) -> Totals:
+    """The trace's totals, recomputed from its calls when the method left them empty."""
+    t = trace.totals
+    if t.calls == 0 and trace.calls:
+        return trace.compute_totals()
+    return t
+
+
+def cost_row(trace: Trace) -> dict[str, Any]:
+    t = trace_totals(trace)
+    return {
+        "calls": t.calls,
+        "total_tokens": t.total_tokens,
+        "prompt_tokens": t.prompt_tokens,
+        "completion_tokens": t.completion_tokens,
+        "image_tokens": t.image_tokens,
+        "cached_calls": t.cached_calls,
+        "parse_failures": t.parse_failures,
+        "latency_s": t.latency_s,
+    }
+
+
+def cost_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Mean ± SE tokens and calls per video for each (variant, frames) pair."""
+    out = []
+    ok = [r for r in rows if not r.get("error")]
+    for metric in ("total_tokens", "calls", "prompt_tokens", "completion_tokens"):
+        stats = group_mean_se(ok, metric, lambda r: (r["variant"], r["method"], r["n_frames"]))
+        for (variant, method, n_frames), (mean, se, n) in sorted(stats.items()):
+            out.append(
+                {
+                    "variant": variant,
+                    "method": method,
+                    "frames": n_frames,
+                    "metric": metric,
+                    "mean": finite_or_none(mean),
+                    "se": finite_or_none(se),
+                    "n": n,
+                }
+            )
+    return out

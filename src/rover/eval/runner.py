@@ -1,0 +1,310 @@
+"""The evaluation runner: every (episode, variant) through method, judge and QA, resumably.
+
+Episodes run concurrently on one asyncio loop, at most `concurrency` at a time; inside an
+episode its variants run concurrently too, and each backend bounds its own calls in
+flight. A work unit is one (episode, variant) with three stages, trace -> judgement ->
+QA answers; each stage's file is written atomically the moment it is done, so a run
+killed at any point keeps all finished stages and `--resume` does only the rest. Video
+decoding and file writes go through `asyncio.to_thread` so the loop never stalls.
+A unit that fails (corrupt video, backend error, a bug in a method) is recorded under
+`errors/` and the run goes on; a later resume retries it.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, Field
+
+from rover.episode import Episode
+from rover.errors import InputError, RoverError
+from rover.eval.episodes import (
+    EpisodeRef,
+    dataset_refs,
+    load_for_variants,
+    source_refs,
+    variant_episode,
+)
+from rover.eval.judge import llm_judge_trace, rule_judge_trace
+from rover.eval.qa import llm_answer_trace, rule_answer_trace
+from rover.eval.rundir import RunDir, write_json_atomic
+from rover.eval.runconfig import run_config
+from rover.eval.variants import Variant, expand_variants
+from rover.methods.trace import Trace
+from rover.vlm.config import BackendConfig
+
+OFF = ("none", "off", "skip")
+
+
+class EvalOptions(BaseModel):
+    """Everything `rover eval` was asked to do (the CLI builds it; library users may too)."""
+
+    dataset: Path | None = None
+    sources: list[str] = Field(default_factory=list)
+    methods: list[str]
+    backends: list[str]
+    judge: str = "rule"
+    answerer: str = "rule"
+    frames: list[int | None] = Field(default_factory=lambda: [None])
+    windows: list[int | None] = Field(default_factory=lambda: [None])
+    views: list[str | None] = Field(default_factory=lambda: [None])
+    concurrency: int = 16
+    limit: int | None = None
+    episodes: int | None = None  # sample this many per source
+    seed: int = 0
+    out: Path
+    resume: bool = False
+    backend_config: BackendConfig = Field(default_factory=BackendConfig)
+    command: list[str] = Field(default_factory=list)
+
+
+@dataclass
+class RunState:
+    """Counters the progress display reads."""
+
+    episodes_total: int = 0
+    episodes_done: int = 0
+    units_total: int = 0
+    units_done: int = 0
+    units_skipped: int = 0
+    calls: int = 0
+    tokens: int = 0
+    errors: int = 0
+    last_error: str = ""
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+OnUpdate = Callable[[RunState], None]
+
+
+def episode_refs(opts: EvalOptions) -> list[EpisodeRef]:
+    if (opts.dataset is None) == (not opts.sources):
+        raise InputError("give exactly one of --dataset DIR or --source SPEC")
+    if opts.dataset is not None:
+        refs = dataset_refs(opts.dataset, opts.episodes, opts.seed)
+    else:
+        refs = source_refs(opts.sources, opts.episodes, opts.seed)
+    if opts.limit is not None:
+        if opts.limit <= 0:
+            raise InputError(f"--limit must be positive, got {opts.limit}")
+        refs = refs[: opts.limit]
+    return refs
+
+
+def check_methods(methods: list[str]) -> None:
+    from rover.methods.registry import get_method
+
+    for m in methods:
+        get_method(m)  # unknown names raise InputError listing the valid ones
+
+
+def _load_backend(spec: str, config: BackendConfig) -> Any:
+    from rover.vlm import load_vlm
+
+    return load_vlm(spec, config)
+
+
+def _warm_up() -> None:
+    """Pay one-time costs (token encodings) here, not on the event loop mid-run."""
+    try:
+        from rover.vlm.tokens import estimate_text_tokens
+
+        estimate_text_tokens("warm up")
+    except Exception:  # noqa: BLE001 - only an optimisation
+        pass
+
+
+class Runner:
+    """One evaluation run; `await runner.run()` does all pending work."""
+
+    def __init__(
+        self,
+        opts: EvalOptions,
+        config: dict[str, Any],
+        refs: list[EpisodeRef],
+        variants: list[Variant],
+        on_update: OnUpdate | None = None,
+    ) -> None:
+        self.opts = opts
+        self.rundir = RunDir(opts.out)
+        self.config = config
+        self.refs = refs
+        self.variants = variants
+        self.on_update = on_update or (lambda s: None)
+        self.state = RunState(episodes_total=len(refs), units_total=len(refs) * len(variants))
+        self.stages = ["trace"]
+        if opts.judge.lower() not in OFF:
+            self.stages.append("judge")
+        if opts.answerer.lower() not in OFF:
+            self.stages.append("qa")
+        self.vlms = {b: _load_backend(b, opts.backend_config) for b in opts.backends}
+        self.judge_vlm = self._aux(opts.judge)
+        self.answer_vlm = self._aux(opts.answerer)
+
+    def _aux(self, spec: str) -> Any:
+        if spec.lower() in OFF or spec.lower() == "rule":
+            return None
+        if spec in self.vlms:
+            return self.vlms[spec]
+        config = self.opts.backend_config.model_copy(update={"flip_prob": 0.0, "jitter": 0.0})
+        return _load_backend(spec, config)
+
+    def _pending(self, ref: EpisodeRef) -> list[Variant]:
+        return [
+            v
+            for v in self.variants
+            if not all(self.rundir.done(s, ref.id, v.id) for s in self.stages)
+        ]
+
+    async def run(self) -> RunState:
+        sem = asyncio.Semaphore(max(1, self.opts.concurrency))
+        self.on_update(self.state)
+        await asyncio.gather(*(self._episode(ref, sem) for ref in self.refs))
+        await asyncio.to_thread(self.rundir.write_errors_file)
+        return self.state
+
+    async def _episode(self, ref: EpisodeRef, sem: asyncio.Semaphore) -> None:
+        pending = self._pending(ref)
+        skipped = len(self.variants) - len(pending)
+        self.state.units_done += skipped
+        self.state.units_skipped += skipped
+        if not pending:
+            self.state.episodes_done += 1
+            self.on_update(self.state)
+            return
+        async with sem:
+            try:
+                meta, loaded = await asyncio.to_thread(load_for_variants, ref, pending)
+                if not self.rundir.episode_path(ref.id).exists():
+                    await asyncio.to_thread(
+                        write_json_atomic, self.rundir.episode_path(ref.id), meta
+                    )
+            except Exception as exc:  # noqa: BLE001 - one bad episode must not end the run
+                for v in pending:
+                    await self._fail(ref, v, "load", exc)
+                self.state.episodes_done += 1
+                self.on_update(self.state)
+                return
+            await asyncio.gather(*(self._unit(ref, meta, loaded, v) for v in pending))
+        self.state.episodes_done += 1
+        self.on_update(self.state)
+
+    async def _fail(self, ref: EpisodeRef, v: Variant, stage: str, exc: BaseException) -> None:
+        msg = str(exc) if isinstance(exc, RoverError) else f"{type(exc).__name__}: {exc}"
+        if not isinstance(exc, RoverError):
+            tb = traceback.format_exception(exc)
+            msg += " | " + "".join(tb[-3:]).strip().replace("\n", " | ")[-600:]
+        from rover.vlm.keys import scrub
+
+        msg = scrub(msg)
+        await asyncio.to_thread(self.rundir.record_error, ref.id, v.id, stage, msg)
+        self.rundir.log_unit(ref.id, v.id, stage, "error", error=msg[:300])
+        self.state.errors += 1
+        self.state.units_done += 1
+        self.state.last_error = f"{ref.id} {v.label}: {msg.split(' | ')[0][:120]}"
+        self.on_update(self.state)
+
+    async def _unit(self, ref: EpisodeRef, meta: Episode, loaded: Episode, v: Variant) -> None:
+        stage = "trace"
+        try:
+            episode = variant_episode(loaded, meta.frame_indices, v)
+            trace = await self._trace(ref, episode, v)
+            stage = "judge"
+            if "judge" in self.stages and not self.rundir.done("judge", ref.id, v.id):
+                await self._judge(ref, episode, trace, v)
+            stage = "qa"
+            if "qa" in self.stages and not self.rundir.done("qa", ref.id, v.id):
+                await self._qa(ref, episode, trace, v)
+        except Exception as exc:  # noqa: BLE001 - recorded, the run goes on
+            await self._fail(ref, v, stage, exc)
+            return
+        await asyncio.to_thread(self.rundir.clear_error, ref.id, v.id)
+        self.state.units_done += 1
+        self.on_update(self.state)
+
+    async def _trace(self, ref: EpisodeRef, episode: Episode, v: Variant) -> Trace:
+        path = self.rundir.trace_path(ref.id, v.id)
+        if path.exists():
+            return await asyncio.to_thread(Trace.load, path)
+        from rover.methods.registry import get_method
+
+        method = get_method(v.method, **v.params)
+        vlm = self.vlms[v.backend].bind(episode)
+        self.rundir.log_unit(ref.id, v.id, "trace", "start")
+        trace = await method.run(episode, vlm)
+        if trace.totals.calls == 0 and trace.calls:
+            trace.totals = trace.compute_totals()
+        await asyncio.to_thread(trace.save, path)
+        self.rundir.log_unit(ref.id, v.id, "trace", "done", calls=trace.totals.calls)
+        self.state.calls += trace.totals.calls
+        self.state.tokens += trace.totals.total_tokens
+        return trace
+
+    async def _judge(self, ref: EpisodeRef, episode: Episode, trace: Trace, v: Variant) -> None:
+        self.rundir.log_unit(ref.id, v.id, "judge", "start")
+        if self.judge_vlm is None:
+            result = rule_judge_trace(trace, episode, v.id)
+        else:
+            vlm = self.judge_vlm.bind(episode)
+            result = await llm_judge_trace(trace, episode, v.id, vlm, self.opts.judge)
+        await asyncio.to_thread(
+            write_json_atomic, self.rundir.stage_path("judge", ref.id, v.id), result
+        )
+        self.rundir.log_unit(ref.id, v.id, "judge", "done", calls=result.calls)
+        self.state.calls += result.calls
+        self.state.tokens += result.total_tokens
+
+    async def _qa(self, ref: EpisodeRef, episode: Episode, trace: Trace, v: Variant) -> None:
+        self.rundir.log_unit(ref.id, v.id, "qa", "start")
+        if self.answer_vlm is None:
+            result = rule_answer_trace(trace, episode, v.id)
+        else:
+            vlm = self.answer_vlm.bind(episode)
+            result = await llm_answer_trace(trace, episode, v.id, vlm, self.opts.answerer)
+        await asyncio.to_thread(
+            write_json_atomic, self.rundir.stage_path("qa", ref.id, v.id), result
+        )
+        self.rundir.log_unit(ref.id, v.id, "qa", "done", calls=result.calls)
+        self.state.calls += result.calls
+        self.state.tokens += result.total_tokens
+
+
+def build_variants(opts: EvalOptions) -> list[Variant]:
+    return expand_variants(opts.methods, opts.backends, opts.frames, opts.windows, opts.views)
+
+
+def prepare_run(opts: EvalOptions, on_update: OnUpdate | None = None) -> Runner:
+    """Check every input, load the backends and set up the run directory (no VLM calls).
+
+    Raises:
+        InputError: unknown method, bad sweep value, missing dataset, non-empty --out...
+    """
+    check_methods(opts.methods)
+    variants = build_variants(opts)
+    refs = episode_refs(opts)
+    _warm_up()
+    config = run_config(opts, variants, refs)
+    runner = Runner(opts, config, refs, variants, on_update)  # loads backends: fail before writing
+    RunDir(opts.out).prepare(config, opts.resume)
+    return runner
+
+
+async def finish_run(runner: Runner) -> tuple[RunState, dict]:
+    """Do all pending work, then write metrics.json and summary.md."""
+    from rover.eval.results import compute_metrics, write_results
+
+    state = await runner.run()
+    metrics = await asyncio.to_thread(compute_metrics, runner.rundir, runner.config)
+    await asyncio.to_thread(write_results, runner.rundir, metrics)
+    return state, metrics
+
+
+async def run_eval(opts: EvalOptions, on_update: OnUpdate | None = None) -> tuple[RunState, dict]:
+    """Run (or resume) an evaluation; returns the final counters and metrics.json's data."""
+    runner = await asyncio.to_thread(prepare_run, opts, on_update)
+    return await finish_run(runner)

@@ -1,0 +1,247 @@
+"""summary.md: the paper-style tables of a run, rendered from metrics.json's data."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rover.eval.aggregate import fmt_mean_se
+
+MAIN_COLUMNS = [
+    # (header, source, metric, digits)
+    ("Pearson r", "agg", "pearson", 2),
+    ("L2", "agg", "l2", 1),
+    ("VOC", "agg", "voc", 2),
+    ("Corr. frame #", "agg", "frame_corr", 2),
+    ("Error rate", "agg", "error_rate", 2),
+    ("Success rate", "agg", "success_rate", 2),
+    ("QA acc.", "qa", "accuracy", 2),
+    ("QA prec.", "qa", "precision", 2),
+    ("QA recall", "qa", "recall", 2),
+    ("QA |Δt|", "qa", "abs_distance", 1),
+    ("Tokens/video", "agg", "total_tokens", 0),
+    ("Calls/video", "agg", "calls", 1),
+]
+LEVEL_NAMES = {
+    "task_group": "task group",
+    "level": "level",
+    "nonexpert": "non-expert share",
+    "state_type": "state type",
+    "context": "frames in context",
+    "view": "camera view",
+    "backend": "backend",
+    "frames": "frames per video",
+    "window": "window",
+    "dataset": "dataset",
+}
+
+
+def _agg_index(metrics: dict[str, Any]) -> dict[tuple, dict[str, Any]]:
+    return {
+        (a["variant"], a["metric"], a["by"], str(a["group"])): a
+        for a in metrics.get("aggregates", [])
+    }
+
+
+COMPACT = ("Pearson r", "L2", "VOC", "Error rate", "Success rate", "QA acc.", "Tokens/video",
+           "Calls/video")
+
+
+def main_rows(
+    metrics: dict[str, Any], compact: bool = False
+) -> tuple[list[str], list[list[str]]]:
+    """(headers, rows) of the main table: one row per variant (compact: for terminals)."""
+    idx = _agg_index(metrics)
+    qa = {(q["variant"]): q for q in metrics.get("qa_pooled", []) if q["by"] == "all"}
+    columns = [c for c in MAIN_COLUMNS if not compact or c[0] in COMPACT]
+    headers = ["Method"] + [c[0] for c in columns] + ["n"]
+    rows = []
+    for v in metrics.get("variants", []):
+        cells = [v["label"] or v["id"]]
+        n = 0
+        for _, src, metric, digits in columns:
+            if src == "agg":
+                a = idx.get((v["id"], metric, "all", "all"))
+                if a is None:
+                    cells.append("–")
+                    continue
+                n = max(n, a["n"])
+                cells.append(_fmt(a["mean"], None if compact else a["se"], digits))
+            else:
+                q = qa.get(v["id"])
+                cells.append(_fmt(q.get(metric) if q else None, None, digits))
+        cells.append(str(n))
+        rows.append(cells)
+    return headers, rows
+
+
+def _fmt(mean: Any, se: Any, digits: int) -> str:
+    if mean is None:
+        return "–"
+    if digits == 0:
+        return f"{mean:,.0f}" + (f" ± {se:,.0f}" if se is not None else "")
+    return fmt_mean_se(mean, float("nan") if se is None else se, digits)
+
+
+def pivot(
+    metrics: dict[str, Any], metric: str, by: str, digits: int = 2
+) -> tuple[list[str], list[list[str]]] | None:
+    """Rows = groups of `by`, columns = variants; None when the run has no such groups."""
+    aggs = [a for a in metrics.get("aggregates", []) if a["by"] == by and a["metric"] == metric]
+    if not aggs:
+        return None
+    variants = [
+        v for v in metrics.get("variants", []) if any(a["variant"] == v["id"] for a in aggs)
+    ]
+    groups = sorted({a["group"] for a in aggs}, key=_group_key)
+    cell = {(a["variant"], a["group"]): a for a in aggs}
+    headers = [LEVEL_NAMES.get(by, by)] + [v["label"] or v["id"] for v in variants]
+    rows = []
+    for g in groups:
+        row = [str(g)]
+        for v in variants:
+            a = cell.get((v["id"], g))
+            ok = a is not None and a["mean"] is not None
+            row.append(_fmt(a["mean"], a["se"], digits) + f" (n={a['n']})" if ok else "–")
+        rows.append(row)
+    return headers, rows
+
+
+def _group_key(g: Any) -> tuple:
+    s = str(g)
+    head = s.split("-")[0].rstrip("%")
+    return (0, float(head), s) if head.replace(".", "").isdigit() else (1, 0.0, s)
+
+
+def markdown_table(headers: list[str], rows: list[list[str]]) -> str:
+    esc = [[c.replace("|", "\\|") for c in r] for r in [headers] + rows]
+    lines = ["| " + " | ".join(esc[0]) + " |", "|" + "---|" * len(headers)]
+    lines += ["| " + " | ".join(r) + " |" for r in esc[1:]]
+    return "\n".join(lines)
+
+
+def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
+    """The whole summary.md."""
+    out = ["# rover eval summary", ""]
+    src = run.get("dataset") or ", ".join(run.get("sources", []))
+    out += [
+        f"- data: `{src}`  ",
+        f"- episodes: {len(run.get('episodes', []))}  ",
+        f"- backends: {', '.join(run.get('backends', []))}  ",
+        f"- judge: {run.get('judge')}, QA answerer: {run.get('answerer')}",
+        "",
+    ]
+    if any(b == "oracle" for b in run.get("backends", [])):
+        out += [
+            "> Traces from the `oracle` backend answer from simulator ground truth: they are",
+            "> an upper bound / pipeline check, not a VLM's performance.",
+            "",
+        ]
+    out += [
+        "## Main results (mean ± standard error over videos)",
+        "",
+        markdown_table(*main_rows(metrics)),
+        "",
+    ]
+    sections = [
+        ("Task 1: Pearson r by task group (Fig. 3)", "pearson", "task_group", 2),
+        ("Task 1: Pearson r by level", "pearson", "level", 2),
+        ("Task 1: L2 distance by level (App. A.1)", "l2", "level", 1),
+        (
+            "Task 1: correlation with frame number by non-expert share (App. A.1)",
+            "frame_corr",
+            "nonexpert",
+            2,
+        ),
+        ("Task 2: error rate by level (Fig. 4)", "error_rate", "level", 2),
+        ("Task 2: success rate by level (App. A.2)", "success_rate", "level", 2),
+        ("Task 2: error rate by task group", "error_rate", "task_group", 2),
+        ("App. G: Pearson r by state type", "pearson", "state_type", 2),
+        ("App. G: Pearson r by frames in context", "pearson", "context", 2),
+        ("App. G: error rate by state type", "error_rate", "state_type", 2),
+        ("App. G: error rate by frames in context", "error_rate", "context", 2),
+        ("App. L: VOC by dataset", "voc", "dataset", 3),
+        ("App. L: Pearson r (vs frame number) by dataset", "pearson", "dataset", 3),
+    ]
+    for title, metric, by, digits in sections:
+        t = pivot(metrics, metric, by, digits)
+        if t is not None and (by != "dataset" or len(t[1]) > 0):
+            out += [f"## {title}", "", markdown_table(*t), ""]
+    out += _cost_section(metrics) + _error_section(metrics) + _counts_section(metrics)
+    return "\n".join(out).rstrip() + "\n"
+
+
+def _cost_section(metrics: dict[str, Any]) -> list[str]:
+    rows: dict[tuple, dict[str, Any]] = {}
+    labels = {v["id"]: v["label"] for v in metrics.get("variants", [])}
+    for c in metrics.get("cost", []):
+        rows.setdefault((c["variant"], c["frames"]), {})[c["metric"]] = c
+    if not rows:
+        return []
+    body = []
+    for (variant, frames), m in sorted(rows.items(), key=lambda kv: (str(kv[0][1]), kv[0][0])):
+        tok, calls = m.get("total_tokens"), m.get("calls")
+        body.append(
+            [
+                labels.get(variant, variant),
+                str(frames),
+                _fmt(tok["mean"], tok["se"], 0) if tok else "–",
+                _fmt(calls["mean"], calls["se"], 1) if calls else "–",
+                str(tok["n"] if tok else 0),
+            ]
+        )
+    headers = ["Method", "Frames", "Avg tokens per video", "Avg VLM calls per video", "n"]
+    return ["## Inference cost (App. G)", "", markdown_table(headers, body), ""]
+
+
+def _error_section(metrics: dict[str, Any]) -> list[str]:
+    rows = metrics.get("error_analysis", [])
+    if not rows:
+        return []
+    variants = list(dict.fromkeys(r["variant"] for r in rows))
+    labels = {v["id"]: v["label"] for v in metrics.get("variants", [])}
+    names = {
+        "incorrect_subtask": "Incorrect subtasks",
+        "redundant_subtask": "Redundant subtasks",
+        "perception": "Perception error",
+        "reasoning": "Reasoning error",
+        "total": "Total",
+    }
+    cell = {(r["variant"], r["error_type"]): r for r in rows}
+    body = []
+    for k, name in names.items():
+        line = [name]
+        for v in variants:
+            r = cell.get((v, k))
+            line.append("NA" if not r or r["mean"] is None else f"{100 * r['mean']:.0f}%")
+        body.append(line)
+    return [
+        "## Error analysis: share of videos with each error type (App. D, derived)",
+        "",
+        markdown_table(["Error type"] + [labels.get(v, v) for v in variants], body),
+        "",
+        "Derivation rules: docs/evaluation.md#error-analysis.",
+        "",
+    ]
+
+
+def _counts_section(metrics: dict[str, Any]) -> list[str]:
+    c = metrics.get("counts", {})
+    out = [
+        "## Counts",
+        "",
+        f"- traces scored: {c.get('traces', 0)} of {c.get('units', 0)} "
+        f"(failed or not run: {c.get('failed', 0)})",
+        f"- constant predictions (VOC and Pearson scored 0): {c.get('voc_constant', 0)}",
+        f"- Pearson undefined (constant ground truth, left out): {c.get('pearson_undefined', 0)}",
+        f"- parse failures in traces: {c.get('parse_failures', 0)}",
+        "",
+    ]
+    failed = [r for r in metrics.get("per_trace", []) if r.get("error")]
+    if failed:
+        out += ["### Failed units", ""]
+        for r in failed[:30]:
+            out.append(f"- `{r['episode_id']}` / `{r['variant']}`: {str(r['error'])[:200]}")
+        if len(failed) > 30:
+            out.append(f"- ... and {len(failed) - 30} more (errors.jsonl)")
+        out.append("")
+    return out

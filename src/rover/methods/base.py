@@ -1,0 +1,206 @@
+"""What every reasoning method shares: the interface, image parts, and a call recorder.
+
+A method turns an Episode and a VLM into a Trace. The `Session` here makes each VLM
+call, re-asks once with a format reminder when the reply cannot be used, and records
+every call (frames sent, tokens, latency, cache hit, parse outcome) in the trace, so the
+methods themselves only say *what* to ask and what to do with the answer.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from typing import Any, TypeVar
+
+from rover.episode import Episode
+from rover.methods.trace import CallRecord, FrameRecord, Trace
+from rover.vlm.types import (
+    VLM,
+    Completion,
+    EncodedImage,
+    ImageEncoding,
+    ImagePart,
+    Message,
+    Prompt,
+    PromptMeta,
+    TextPart,
+)
+
+T = TypeVar("T")
+
+
+@dataclass
+class StepInfo:
+    """Progress report for live displays (`on_step`): where the method is, what it said."""
+
+    position: int  # sampled position just answered
+    num_frames: int
+    subtask_path: list[str] = field(default_factory=list)
+    progress: float | None = None  # the value the model gave (its own line's scale)
+    calls: int = 0
+
+
+OnStep = Callable[[StepInfo], None]
+
+
+class Method:
+    """Base of every reasoning method: a name, its parameters, and `run`."""
+
+    name: str = ""
+
+    def __init__(self, **params: Any) -> None:
+        self.params: dict[str, Any] = params
+
+    async def run(self, episode: Episode, vlm: VLM, on_step: OnStep | None = None) -> Trace:
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.params})"
+
+
+class Session:
+    """One method run on one episode: encodes frames once, makes and records calls."""
+
+    def __init__(self, method: Method, episode: Episode, vlm: VLM, on_step: OnStep | None) -> None:
+        self.episode = episode
+        self.vlm = vlm
+        self.on_step = on_step
+        self.frames = episode.frames()
+        self.encoding: ImageEncoding = getattr(vlm, "image_encoding", None) or ImageEncoding()
+        self._parts: dict[int, ImagePart] = {}
+        self.trace = Trace(
+            method=method.name,
+            params=dict(method.params),
+            backend=vlm.backend,
+            model=vlm.model,
+            oracle=vlm.backend == "oracle",
+            episode_id=episode.id,
+            task=episode.task,
+            view=episode.view,
+            num_frames=episode.num_frames,
+            frame_indices=list(episode.frame_indices),
+            frames=[
+                FrameRecord(index=idx, position=pos)
+                for pos, idx in enumerate(episode.frame_indices)
+            ],
+        )
+
+    @property
+    def num_frames(self) -> int:
+        return self.episode.num_frames
+
+    def image(self, position: int) -> ImagePart:
+        """The image part of one frame; each frame is encoded once per run."""
+        part = self._parts.get(position)
+        if part is None:
+            enc = EncodedImage.from_any(self.frames[position], self.encoding)
+            part = ImagePart(image=enc, frame_index=self.episode.frame_indices[position])
+            self._parts[position] = part
+        return part
+
+    def meta(self, kind: str, positions: list[int], **kw: Any) -> PromptMeta:
+        return PromptMeta(
+            kind=kind,
+            positions=list(positions),
+            frame_indices=[self.episode.frame_indices[p] for p in positions],
+            **kw,
+        )
+
+    async def ask(
+        self,
+        system: str,
+        content: list[TextPart | ImagePart],
+        meta: PromptMeta,
+        parse: Callable[[str], T],
+        usable: Callable[[T], bool],
+        reminder: str,
+        line_id: int | None = None,
+    ) -> tuple[T, bool]:
+        """Ask; on an unusable reply ask once more with a format reminder.
+
+        Returns (parsed reply, ok). When both replies are unusable, `ok` is False and the
+        second reply's parse is returned so callers can salvage what is there.
+        """
+        messages = [Message(role="system", content=system), Message(role="user", content=content)]
+        prompt = Prompt(messages=messages, meta=meta)
+        completion = await self._complete(prompt)
+        parsed = parse(completion.text)
+        if usable(parsed):
+            self._record(prompt, completion, "ok", line_id)
+            return parsed, True
+        first = self._record(prompt, completion, "retried", line_id)
+        retry = Prompt(
+            messages=[
+                *messages,
+                Message(role="assistant", content=completion.text or "(empty reply)"),
+                Message(role="user", content=reminder),
+            ],
+            meta=meta.model_copy(update={"extra": {**meta.extra, "reminder": True}}),
+        )
+        completion2 = await self._complete(retry)
+        parsed2 = parse(completion2.text)
+        ok = usable(parsed2)
+        rec = self._record(retry, completion2, "ok" if ok else "failed", line_id)
+        del first, rec  # both calls are in the trace: "retried", then "ok" or "failed"
+        return parsed2, ok
+
+    async def _complete(self, prompt: Prompt) -> Completion:
+        t0 = time.perf_counter()
+        completion = await self.vlm.complete(prompt)
+        if not completion.latency_s:
+            completion = completion.model_copy(update={"latency_s": time.perf_counter() - t0})
+        return completion
+
+    def _record(
+        self, prompt: Prompt, completion: Completion, parse: str, line_id: int | None
+    ) -> CallRecord:
+        u = completion.usage
+        rec = CallRecord(
+            id=len(self.trace.calls),
+            kind=prompt.meta.kind,
+            frame_indices=list(prompt.meta.frame_indices),
+            line_id=line_id,
+            subtask_path=list(prompt.meta.subtask_path),
+            prompt_tokens=u.prompt_tokens,
+            completion_tokens=u.completion_tokens,
+            image_tokens=u.image_tokens,
+            usage_source=u.source,
+            latency_s=completion.latency_s,
+            cached=completion.cached,
+            parse=parse,  # type: ignore[arg-type]
+            response=completion.text,
+        )
+        self.trace.calls.append(rec)
+        return rec
+
+    def step(self, position: int, subtask_path: list[str], progress: float | None) -> None:
+        """Tell the live display a frame was answered."""
+        if self.on_step is not None:
+            self.on_step(
+                StepInfo(
+                    position=position,
+                    num_frames=self.num_frames,
+                    subtask_path=list(subtask_path),
+                    progress=progress,
+                    calls=len(self.trace.calls),
+                )
+            )
+
+    def finish(self) -> Trace:
+        """Totals and timestamps; frame 0 is 0 and gaps are filled forward."""
+        last = 0.0
+        for i, fr in enumerate(self.trace.frames):
+            if i == 0:
+                fr.progress = 0.0
+            elif fr.progress is None:
+                fr.progress = last
+            last = fr.progress
+        self.trace.totals = self.trace.compute_totals()
+        self.trace.finished_at = datetime.now(UTC).isoformat()
+        return self.trace
+
+
+def text(s: str) -> TextPart:
+    return TextPart(text=s)

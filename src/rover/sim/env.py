@@ -1,0 +1,270 @@
+"""robosuite environment wrapper: the `SimAdapter` the trajectory and value code drive.
+
+One `SimEnv` per task per process. It builds the robosuite environment without any
+camera or renderer (simulation runs at full rate; frames are rendered later from saved
+states by `rover.sim.render`), reseeds it per episode, and answers the named points and
+predicates a `TaskSpec` mentions, reading MuJoCo data directly so that any saved state
+can be measured again after `set_state`.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+
+import mujoco
+import numpy as np
+
+from rover.errors import MissingExtraError
+from rover.sim.interp import interpolate_state
+from rover.sim.tasks.base import TaskSpec
+
+CONTROL_FREQ = 20  # Hz; the expert and every deviation step run at this rate
+LIFT_HEIGHT = 0.04  # m above its start height for an object to count as lifted
+
+
+def _import_robosuite():
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        import robosuite
+        from robosuite.controllers import load_composite_controller_config
+    except ImportError as exc:  # pragma: no cover - depends on the install
+        raise MissingExtraError("robosuite", "sim", "simulated benchmark generation") from exc
+    for name in ("robosuite", "robosuite_logs"):
+        logging.getLogger(name).setLevel(logging.ERROR)
+    return robosuite, load_composite_controller_config
+
+
+def make_robosuite_env(env_name: str, env_kwargs: dict | None = None):
+    """Build a camera-less Panda + OSC_POSE robosuite environment (fast to step)."""
+    suite, load_cfg = _import_robosuite()
+    controller = load_cfg(controller="BASIC", robot="Panda")
+    kwargs = dict(
+        robots="Panda",
+        controller_configs=controller,
+        has_renderer=False,
+        has_offscreen_renderer=False,
+        use_camera_obs=False,
+        hard_reset=False,
+        control_freq=CONTROL_FREQ,
+        horizon=100_000,
+        ignore_done=True,
+        reward_shaping=False,
+    )
+    kwargs.update(env_kwargs or {})
+    return suite.make(env_name, **kwargs)
+
+
+class SimEnv:
+    """A robosuite task behind the `SimAdapter` protocol, plus facts the generator needs."""
+
+    def __init__(self, spec: TaskSpec) -> None:
+        self.spec = spec
+        self.env = make_robosuite_env(spec.env_name, spec.env_kwargs)
+        self.sim = self.env.sim
+        self.model: mujoco.MjModel = self.sim.model._model
+        self.data: mujoco.MjData = self.sim.data._data
+        low, high = self.env.action_spec
+        self.action_low = np.asarray(low, dtype=np.float64)
+        self.action_high = np.asarray(high, dtype=np.float64)
+        self._robot = self.env.robots[0]
+        self._gripper = self._robot.gripper["right"]
+        self._eef_site = self._robot.eef_site_id["right"]
+        self._finger_geoms = {
+            side: [self._geom_id(g) for g in self._gripper.important_geoms[f"{side}_finger"]]
+            for side in ("left", "right")
+        }
+        self._pad_geoms = {
+            side: self._geom_id(self._gripper.important_geoms[f"{side}_fingerpad"][0])
+            for side in ("left", "right")
+        }
+        fj = [self.model.joint(j) for j in self._gripper.joints]
+        self._finger_qpos = [int(j.qposadr[0]) for j in fj]
+        self._geom_owner = self._object_geoms()
+        self.start_positions: dict[str, np.ndarray] = {}
+
+    # ----------------------------------------------------------------- set-up
+    def _geom_id(self, name: str) -> int:
+        return int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, name))
+
+    def _body_id(self, name: str) -> int:
+        bid = int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name))
+        if bid < 0:
+            raise KeyError(f"no body {name!r} in {self.spec.env_name}")
+        return bid
+
+    def _object_geoms(self) -> dict[int, str]:
+        """geom id -> object name, for every geom in each object's body subtree."""
+        owner: dict[int, str] = {}
+        parents = self.model.body_parentid
+        for obj in self.spec.objects:
+            root = self._body_id(obj.body)
+            for g in range(self.model.ngeom):
+                b = int(self.model.geom_bodyid[g])
+                while b != 0 and b != root:
+                    b = int(parents[b])
+                if b == root:
+                    owner[g] = obj.name
+        return owner
+
+    def reset(self, seed: int) -> np.ndarray:
+        """Reset to the initial configuration drawn from `seed`; return the flat state."""
+        self.env.rng.bit_generator.state = np.random.default_rng(seed).bit_generator.state
+        self.env.reset()
+        # start with the fingers wide open (robosuite starts them half open, which would
+        # read as "closed" in the facts before the first gripper command)
+        self.data.qpos[self._finger_qpos[0]] = 0.04
+        self.data.qpos[self._finger_qpos[1]] = -0.04
+        self.sim.forward()
+        self.start_positions = {o.name: self.point(o.name).copy() for o in self.spec.objects}
+        return self.get_state()
+
+    # ------------------------------------------------------------ SimAdapter
+    def get_state(self) -> np.ndarray:
+        return np.asarray(self.sim.get_state().flatten(), dtype=np.float64)
+
+    def set_state(self, state: np.ndarray) -> None:
+        self.sim.set_state_from_flattened(np.asarray(state, dtype=np.float64))
+        self.sim.forward()
+
+    def step(self, action: np.ndarray) -> None:
+        self.env.step(np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0))
+
+    def interpolate(self, a: np.ndarray, b: np.ndarray, alpha: float) -> np.ndarray:
+        return interpolate_state(self.model, a, b, alpha)
+
+    def entity_positions(self) -> np.ndarray:
+        pts = [self.point("eef")] + [self.point(o.name) for o in self.spec.objects]
+        return np.stack(pts)
+
+    def point(self, name: str) -> np.ndarray:
+        d = self.data
+        if name == "eef":
+            return d.site_xpos[self._eef_site].copy()
+        if name in ("left_finger", "right_finger"):
+            return d.geom_xpos[self._pad_geoms[name.split("_")[0]]].copy()
+        if name.startswith("goal:"):
+            return self.goal(name[5:])
+        obj_name, _, site = name.partition(":")
+        obj = self.spec.object_spec(obj_name)
+        if site:
+            return self._named_xpos(obj.sites[site])
+        return self._named_xpos(obj.centre or obj.body)
+
+    def _named_xpos(self, name: str) -> np.ndarray:
+        sid = int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, name))
+        if sid >= 0:
+            return self.data.site_xpos[sid].copy()
+        return self.data.xpos[self._body_id(name)].copy()
+
+    def success(self) -> bool:
+        return all(self.predicate(s.end_signal) for s in self.spec.subtasks[-1:]) and all(
+            self.predicate(s) for s in self._final_signals()
+        )
+
+    def _final_signals(self) -> list[str]:
+        return [s.end_signal for s in self.spec.subtasks if s.end_signal.startswith("placed:")]
+
+    # ------------------------------------------------------------------ goals
+    def goal(self, name: str) -> np.ndarray:
+        g = self.spec.goals[name]
+        off = np.asarray(g.offset, dtype=np.float64)
+        if g.kind == "bin":
+            idx = self.spec.bins[g.object]
+            return np.asarray(self.env.target_bin_placements[idx], dtype=np.float64) + off
+        if g.kind == "above":
+            return self.point(g.object) + off
+        if g.kind == "body":
+            return self._named_xpos(g.body) + off
+        if g.kind == "start_offset":
+            return self.start_positions[g.object] + off
+        if g.kind == "door_open":
+            return self._door_handle_at(g.angle)
+        raise ValueError(f"unknown goal kind {g.kind}")
+
+    def _door_handle_at(self, angle: float) -> np.ndarray:
+        """Where the handle would be with the door hinge at `angle` radians."""
+        jid = self._hinge_joint()
+        anchor, axis = self.data.xanchor[jid], self.data.xaxis[jid]
+        handle = self.point("door:handle")
+        rot = angle - self.hinge_angle()
+        v = handle - anchor
+        k = axis / np.linalg.norm(axis)
+        v_rot = (
+            v * np.cos(rot) + np.cross(k, v) * np.sin(rot) + k * np.dot(k, v) * (1 - np.cos(rot))
+        )
+        return anchor + v_rot
+
+    def _hinge_joint(self) -> int:
+        return int(
+            mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, self.env.door.joints[0])
+        )
+
+    def hinge_angle(self) -> float:
+        return float(self.data.qpos[self.env.hinge_qpos_addr])
+
+    # ----------------------------------------------------- contacts, gripper
+    def finger_contacts(self) -> dict[str, set[str]]:
+        """Object name -> the fingers ("left"/"right") touching it; robot body excluded."""
+        out: dict[str, set[str]] = {}
+        fingers = {g: side for side, gs in self._finger_geoms.items() for g in gs}
+        for i in range(self.data.ncon):
+            g1, g2 = int(self.data.contact[i].geom1), int(self.data.contact[i].geom2)
+            for a, b in ((g1, g2), (g2, g1)):
+                if a in fingers and b in self._geom_owner:
+                    out.setdefault(self._geom_owner[b], set()).add(fingers[a])
+        return out
+
+    def gripper_opening(self) -> float:
+        """0 = fingers fully closed, 1 = fully open (Panda: 0.08 m between fingers)."""
+        q = self.data.qpos
+        width = abs(q[self._finger_qpos[0]]) + abs(q[self._finger_qpos[1]])
+        return float(np.clip(width / 0.08, 0.0, 1.0))
+
+    # ------------------------------------------------------------- predicates
+    def grasped(self, obj: str) -> bool:
+        touching = self.finger_contacts().get(obj, set())
+        return touching == {"left", "right"}
+
+    def lifted(self, obj: str) -> bool:
+        start = self.start_positions.get(obj)
+        if start is None:
+            return False
+        return bool(self.point(obj)[2] - start[2] > LIFT_HEIGHT)
+
+    def in_bin(self, obj: str) -> int | None:
+        """PickPlace compartment index the object rests in (robosuite's test), if any."""
+        pos = self.point(obj)
+        for i in range(4):
+            if not self.env.not_in_bin(pos, i):
+                return i
+        return None
+
+    def predicate(self, signal: str) -> bool:
+        """Evaluate an end-of-subtask signal such as ``"lifted:can"`` in the current state."""
+        kind, _, obj = signal.partition(":")
+        if kind == "grasped":
+            return self.grasped(obj)
+        if kind == "lifted":
+            return self.lifted(obj) and self.grasped(obj)
+        if kind == "placed":
+            return self.in_bin(obj) == self.spec.bins[obj] and not self.grasped(obj)
+        if kind == "stacked":
+            below = self.spec.goals["on"].object
+            return self.on_top(obj, below) and not self.grasped(obj)
+        if kind == "opened":
+            return self.hinge_angle() > self.spec.goals["door_open"].angle * 0.9
+        if kind == "on_peg":
+            return self.on_peg(obj) and not self.grasped(obj)
+        raise ValueError(f"unknown end signal {signal!r}")
+
+    def on_top(self, obj: str, below: str) -> bool:
+        p, q = self.point(obj), self.point(below)
+        return bool(np.linalg.norm(p[:2] - q[:2]) < 0.03 and 0.03 < p[2] - q[2] < 0.06)
+
+    def on_peg(self, obj: str) -> bool:
+        peg = self.goal("peg")
+        p = self.point(obj)
+        return bool(
+            np.linalg.norm(p[:2] - peg[:2]) < 0.03 and p[2] < self.env.table_offset[2] + 0.05
+        )

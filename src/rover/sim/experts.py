@@ -1,0 +1,278 @@
+"""Scripted experts: closed-loop waypoint controllers on Panda with OSC_POSE actions.
+
+Each expert is a list of phases. A phase names a target for the end effector (a function
+of the current state, so the script reacts to where objects really are), a gripper
+command and when it is done (target reached, a step budget, or both). Actions are
+OSC_POSE deltas: position error scaled to the controller's 5 cm per step and the
+orientation error (keep pointing down, turn to the grasp yaw) as an axis-angle delta.
+The recorded demonstration is the robomimic layout: `states[t]` is the state before
+`actions[t]`; the final action is a hold, so the last state is the finished task.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from rover.sim.env import SimEnv
+
+OPEN, CLOSE = -1.0, 1.0
+POS_SCALE = 0.05  # m per unit action (robosuite OSC_POSE output_max)
+ROT_SCALE = 0.5  # rad per unit action
+
+
+@dataclass
+class Phase:
+    """One leg of a script: move the end effector to `target()` with the gripper set."""
+
+    target: Callable[[], np.ndarray]
+    grip: float
+    tol: float | None = 0.01  # done when within tol (m); None: run `steps` steps
+    steps: int = 60  # step budget (or exact count when tol is None)
+    min_steps: int = 0
+    yaw: Callable[[], float] | None = None  # grasp yaw about world z (rad), None: keep
+    gain: float = 1.0
+    track_yaw: bool = False  # re-evaluate `yaw` every step (turning with a door)
+    done: Callable[[], bool] | None = None  # extra completion test
+
+
+@dataclass
+class Demo:
+    """One expert demonstration: per-step states (before each action) and actions."""
+
+    states: np.ndarray  # (T, S)
+    actions: np.ndarray  # (T, A)
+    success: bool
+    subtask_ends: list[int]  # first step index at which each subtask's end signal holds
+
+
+def _yaw_of(mat: np.ndarray) -> float:
+    return float(np.arctan2(mat[1, 0], mat[0, 0]))
+
+
+def _wrap(angle: float, period: float) -> float:
+    """Angle folded into [-period/2, period/2) (symmetric grasps)."""
+    return float((angle + period / 2) % period - period / 2)
+
+
+class Scripted:
+    """Runs phases on a SimEnv, recording states and actions."""
+
+    def __init__(self, sim: SimEnv) -> None:
+        self.sim = sim
+        self.down = sim.data.site_xmat[sim._eef_site].reshape(3, 3).copy()
+        self.yaw0 = 0.0
+        self.tilt = 0.0  # rotation about world x applied before the yaw (door handle)
+        self.states: list[np.ndarray] = []
+        self.actions: list[np.ndarray] = []
+
+    def action(self, target: np.ndarray, grip: float, yaw: float, gain: float) -> np.ndarray:
+        sim = self.sim
+        err = target - sim.point("eef")
+        pos = np.clip(gain * err / POS_SCALE, -1.0, 1.0)
+        cur = sim.data.site_xmat[sim._eef_site].reshape(3, 3)
+        want = Rotation.from_euler("zx", [yaw, self.tilt]).as_matrix() @ self.down
+        rotvec = Rotation.from_matrix(want @ cur.T).as_rotvec()
+        rot = np.clip(rotvec / ROT_SCALE, -1.0, 1.0)
+        return np.concatenate([pos, rot, [grip]])
+
+    def run(self, phase: Phase) -> None:
+        yaw = self.yaw0 if phase.yaw is None else phase.yaw()
+        self.yaw0 = yaw
+        for k in range(phase.steps):
+            if phase.done is not None and phase.done():
+                return
+            if phase.track_yaw and phase.yaw is not None:
+                yaw = phase.yaw()
+            target = phase.target()
+            if (
+                phase.tol is not None
+                and k >= phase.min_steps
+                and np.linalg.norm(target - self.sim.point("eef")) < phase.tol
+            ):
+                return
+            act = self.action(target, phase.grip, yaw, phase.gain)
+            self.states.append(self.sim.get_state())
+            self.actions.append(act)
+            self.sim.step(act)
+
+
+def grasp_yaw(sim: SimEnv, obj: str, period: float) -> float:
+    """Gripper yaw that lines the fingers up with the object's faces (mod `period`)."""
+    spec = sim.spec.object_spec(obj)
+    mat = sim.data.xmat[sim._body_id(spec.body)].reshape(3, 3)
+    return _wrap(_yaw_of(mat), period)
+
+
+def pick_phases(
+    sim: SimEnv, obj: str, period: float | None, grasp_dz: float = 0.0, point: str | None = None
+) -> list[Phase]:
+    """Approach from above, descend, close, lift."""
+    where = point or obj
+
+    def above() -> np.ndarray:
+        return sim.point(where) + np.array([0, 0, 0.10])
+
+    def at() -> np.ndarray:
+        return sim.point(where) + np.array([0, 0, grasp_dz])
+
+    yaw = (lambda: grasp_yaw(sim, obj, period)) if period else (lambda: 0.0)
+    hold = [None]
+
+    def here() -> np.ndarray:
+        return hold[0]
+
+    def freeze() -> np.ndarray:
+        if hold[0] is None:
+            hold[0] = sim.point("eef")
+        return hold[0]
+
+    start_z = sim.point(obj)[2]
+    return [
+        Phase(above, OPEN, tol=0.015, steps=80, yaw=yaw),
+        Phase(at, OPEN, tol=0.006, steps=40, gain=1.5),
+        Phase(freeze, CLOSE, tol=None, steps=10),
+        Phase(lambda: here() + np.array([0, 0, start_z + 0.15 - here()[2]]), CLOSE, 0.02, 40),
+    ]
+
+
+def place_phases(sim: SimEnv, goal: str, drop_dz: float, carry_z: float) -> list[Phase]:
+    """Carry over the goal at `carry_z`, lower to `drop_dz` above it, release, retreat."""
+
+    def over() -> np.ndarray:
+        g = sim.point(goal)
+        return np.array([g[0], g[1], carry_z])
+
+    def down() -> np.ndarray:
+        return sim.point(goal) + np.array([0, 0, drop_dz])
+
+    rest = [None]
+
+    def freeze() -> np.ndarray:
+        if rest[0] is None:
+            rest[0] = sim.point("eef")
+        return rest[0]
+
+    return [
+        Phase(over, CLOSE, tol=0.02, steps=100),
+        Phase(down, CLOSE, tol=0.01, steps=50),
+        Phase(freeze, OPEN, tol=None, steps=8),
+        Phase(lambda: freeze() + np.array([0, 0, 0.08]), OPEN, tol=0.02, steps=20),
+    ]
+
+
+# grasp symmetry about the vertical axis, per object (None: round, any yaw works)
+_PERIOD = {"cube": np.pi / 2, "red cube": np.pi / 2, "can": None, "milk": np.pi / 2,
+           "bread": np.pi, "cereal": np.pi}
+
+
+def _pick_place_script(sim: SimEnv) -> list[Phase]:
+    phases: list[Phase] = []
+    subs = sim.spec.subtasks
+    for grasp, move in zip(subs[0::2], subs[1::2], strict=True):
+        obj = grasp.object
+        phases += pick_phases(sim, obj, _PERIOD.get(obj))
+        drop = 0.10 if move.end_signal.startswith("placed") else 0.03
+        carry = sim.point(move.goal)[2] + 0.20
+        phases += place_phases(sim, move.goal, drop, carry)
+    return phases
+
+
+def _lift_script(sim: SimEnv) -> list[Phase]:
+    phases = pick_phases(sim, "cube", _PERIOD["cube"])
+    top = [None]
+
+    def stay() -> np.ndarray:
+        if top[0] is None:
+            top[0] = sim.point("eef")
+        return top[0]
+
+    return phases + [Phase(stay, CLOSE, tol=None, steps=10)]
+
+
+def _door_script(sim: SimEnv) -> list[Phase]:
+    goal = sim.spec.goals["door_open"].angle
+    hold = [None]
+
+    def freeze() -> np.ndarray:
+        if hold[0] is None:
+            hold[0] = sim.point("eef")
+        return hold[0]
+
+    def handle() -> np.ndarray:
+        return sim.point("door:handle")
+
+    def pull() -> np.ndarray:
+        # a point a little further along the handle's arc: the door swings open
+        return sim._door_handle_at(sim.hinge_angle() + 0.12)
+
+    rest = [None]
+
+    def let_go() -> np.ndarray:
+        if rest[0] is None:
+            rest[0] = sim.point("eef")
+        return rest[0]
+
+    return [
+        Phase(lambda: handle() + np.array([0, 0, 0.08]), OPEN, tol=0.015, steps=80),
+        Phase(handle, OPEN, tol=0.006, steps=40, gain=1.5),
+        Phase(freeze, CLOSE, tol=None, steps=10),
+        Phase(pull, CLOSE, tol=None, steps=150, yaw=sim.hinge_angle, track_yaw=True, gain=0.6,
+              done=lambda: sim.hinge_angle() > goal + 0.03),
+        Phase(let_go, OPEN, tol=None, steps=8),
+        Phase(lambda: let_go() + np.array([0.0, 0.06, 0.06]), OPEN, tol=0.015, steps=20),
+    ]
+
+
+# the door handle sits close to the panel: lean the hand away from it (rad about x)
+_TILT = {"door": -0.6}
+
+SCRIPTS: dict[str, Callable[[SimEnv], list[Phase]]] = {
+    "lift": _lift_script,
+    "pick_place": _pick_place_script,
+    "stack": _pick_place_script,
+    "door": _door_script,
+}
+
+
+def run_expert(sim: SimEnv, seed: int) -> Demo:
+    """Reset to `seed` and run the task's scripted expert; return the demonstration."""
+    sim.reset(seed)
+    script = Scripted(sim)
+    script.tilt = _TILT.get(sim.spec.expert, 0.0)
+    for phase in SCRIPTS[sim.spec.expert](sim):
+        script.run(phase)
+        if len(script.actions) >= sim.spec.max_expert_steps:
+            break
+    # final hold: the last recorded state is the finished task
+    hold = np.zeros(len(sim.action_low))
+    hold[-1] = script.actions[-1][-1] if script.actions else OPEN
+    script.states.append(sim.get_state())
+    script.actions.append(hold)
+    states = np.stack(script.states)
+    ends = subtask_ends(sim, states)
+    sim.set_state(states[-1])
+    return Demo(
+        states=states,
+        actions=np.stack(script.actions),
+        success=sim.success() and len(ends) == len(sim.spec.subtasks),
+        subtask_ends=ends,
+    )
+
+
+def subtask_ends(sim: SimEnv, states: np.ndarray) -> list[int]:
+    """First step at which each subtask's end signal holds, subtasks taken in order."""
+    ends: list[int] = []
+    k = 0
+    subs = sim.spec.subtasks
+    for t, s in enumerate(states):
+        if k >= len(subs):
+            break
+        sim.set_state(s)
+        if sim.predicate(subs[k].end_signal):
+            ends.append(t)
+            k += 1
+    return ends

@@ -1,0 +1,329 @@
+"""The generator pipeline: expert demos -> perturbed rollouts -> truth -> rendered episodes.
+
+Per task: a few expert demonstrations (scripted, or read from a robomimic/RoboCasa HDF5
+file) form the source dataset D_src and are stored in ``DIR/demos/<task>.hdf5``. Per
+episode: B's `plan_trajectory` + `execute_plan` perturb one demo at the episode's level,
+`ground_truth_value` gives progress for every step, the video's N steps are picked evenly,
+facts/events/QA are read at exactly those steps, only those states are rendered, and
+`write_episode` stores the result atomically. Every random choice comes from Generators
+seeded by (seed, task, index), so a rerun or a resumed run reproduces the same episodes.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from pydantic import BaseModel
+
+from rover.episode import Episode, GroundTruth, StateType, Subtask, even_positions
+from rover.errors import InputError
+from rover.io.dataset import DatasetInfo, episode_ids, write_dataset_info, write_episode
+from rover.sim.levels import LevelSpec, level_schedule, plan_seed
+from rover.sim.tasks import get_task
+from rover.sim.tasks.base import TaskSpec
+
+MAX_FRAMES = 240
+
+
+class GenerateConfig(BaseModel):
+    """Everything that determines a generated dataset (stored in dataset.json)."""
+
+    tasks: list[str]
+    per_level: int = 3
+    levels: list[str] = ["all"]  # level numbers, "last", or "all"
+    frames: int | None = None  # None: each task's default (30 atomic, 60 composite)
+    views: list[str] = ["left", "wrist"]
+    size: int = 256
+    seed: int = 0
+    demos: int = 3  # expert demonstrations per task (source dataset size)
+    source_hdf5: str | None = None
+
+
+@dataclass
+class WorkItem:
+    task: str
+    level: int
+    index: int  # video number within the task (plan seed)
+    k: int  # number within its level
+
+    @property
+    def episode_id(self) -> str:
+        return f"{self.task}-L{self.level}-{self.k:03d}"
+
+
+def select_levels(spec: TaskSpec, wanted: list[str]) -> list[LevelSpec]:
+    if not wanted or "all" in wanted:
+        return list(spec.levels)
+    top = max(lv.level for lv in spec.levels)
+    nums = set()
+    for w in wanted:
+        if w == "last":
+            nums.add(top)
+        elif w.isdigit():
+            nums.add(min(int(w), top))
+        else:
+            raise InputError(f"--levels: {w!r} is not a level number, 'last' or 'all'")
+    return [lv for lv in spec.levels if lv.level in nums]
+
+
+def work_items(cfg: GenerateConfig) -> list[WorkItem]:
+    items = []
+    for name in cfg.tasks:
+        spec = get_task(name)
+        per: dict[int, int] = {}
+        for index, lv in level_schedule(select_levels(spec, cfg.levels), cfg.per_level):
+            k = per.get(lv.level, 0)
+            per[lv.level] = k + 1
+            items.append(WorkItem(name, lv.level, index, k))
+    return items
+
+
+# ------------------------------------------------------------ per process
+@dataclass
+class _TaskState:
+    sim: object
+    renderer: object | None
+    demos: list = field(default_factory=list)  # (states, actions, ends)
+    tracks: dict = field(default_factory=dict)
+
+
+_CACHE: dict[tuple[str, int], _TaskState] = {}
+
+
+def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskState:
+    from rover.sim.demos import read_demos
+    from rover.sim.env import SimEnv
+    from rover.sim.experts import subtask_ends
+    from rover.sim.render import StateRenderer
+
+    key = (spec.name, cfg.size)
+    if key not in _CACHE:
+        sim = SimEnv(spec)
+        demos = []
+        for rec in read_demos(demo_dir / f"{spec.name}.hdf5"):
+            sim.reset(int(rec.ep_meta.get("seed", 0)))
+            ends = rec.ep_meta.get("subtask_ends") or subtask_ends(sim, rec.states)
+            demos.append((rec.states, rec.actions, list(ends)))
+        _CACHE[key] = _TaskState(sim, StateRenderer(sim.model, cfg.size), demos)
+    return _CACHE[key]
+
+
+def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
+    """Source demonstrations for a task: scripted experts, or the user's HDF5 file."""
+    from rover.sim.demos import DemoRecord, read_demos, write_demos
+    from rover.sim.env import SimEnv
+    from rover.sim.experts import run_expert
+
+    path = demo_dir / f"{task}.hdf5"
+    if path.exists():
+        return path
+    spec = get_task(task)
+    if cfg.source_hdf5:
+        recs = read_demos(Path(cfg.source_hdf5), limit=cfg.demos)
+        write_demos(path, spec.env_name, spec.env_kwargs, recs)
+        return path
+    sim = SimEnv(spec)
+    recs = []
+    seed = cfg.seed * 100_003 + 1
+    tries = 0
+    while len(recs) < cfg.demos and tries < cfg.demos * 5:
+        demo = run_expert(sim, seed)
+        if demo.success:
+            recs.append(
+                DemoRecord(
+                    name=f"demo_{len(recs)}",
+                    states=demo.states,
+                    actions=demo.actions,
+                    model_file=sim.env.sim.model.get_xml() if hasattr(
+                        sim.env.sim.model, "get_xml") else None,
+                    ep_meta={"seed": seed, "subtask_ends": demo.subtask_ends, "task": task},
+                )
+            )
+        seed += 1
+        tries += 1
+    if not recs:
+        raise InputError(f"{task}: the scripted expert failed on every seed tried")
+    write_demos(path, spec.env_name, spec.env_kwargs, recs)
+    return path
+
+
+def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
+    """Generate and write one episode; returns its id."""
+    from rover.sim.facts import detect_events, facts_for_states, qa_items
+    from rover.sim.perturb import bounds_from_ends, execute_plan, plan_trajectory
+    from rover.sim.value import point_tracks, required_points
+    from rover.sim.value import progress_from_tracks
+
+    spec = get_task(item.task)
+    ts = _task_state(spec, cfg, out / "demos")
+    sim = ts.sim
+    level = next(lv for lv in spec.levels if lv.level == item.level)
+    rng = plan_seed(cfg.seed, item.task, item.index)
+    d = int(rng.integers(len(ts.demos)))
+    states, actions, ends = ts.demos[d]
+    seed = int(_demo_seed(out, item.task, d))
+    sim.reset(seed)  # start positions (lift heights, goals) of this demo's scene
+    bounds = bounds_from_ends(ends, len(states))
+    plan = plan_trajectory(len(states), bounds, level, rng)
+    roll = execute_plan(sim, states, actions, plan, np.random.default_rng(rng.integers(2**63)))
+    names = required_points(spec.subtasks)
+    if d not in ts.tracks:
+        ts.tracks[d] = point_tracks(sim, states, names)
+    progress = progress_from_tracks(
+        point_tracks(sim, roll.states, names), roll.q, ts.tracks[d], spec.subtasks, bounds
+    )
+    n = min(cfg.frames or spec.frames, MAX_FRAMES)
+    pos = even_positions(len(roll), n)
+    picked = roll.states[pos]
+    facts = facts_for_states(sim, picked)
+    events = detect_events(spec, facts)
+    frames = ts.renderer.render(picked, cfg.views)
+    prog = np.clip(np.asarray(progress)[pos], 0.0, 1.0)
+    prog[0] = 0.0
+    truth = GroundTruth(
+        progress=[float(p) for p in prog],
+        state_type=[roll.state_type[p] for p in pos],
+        subtasks=_subtasks(spec, roll.subtask[pos]),
+        events=events,
+        facts=facts,
+        level=item.level,
+        qa=qa_items(spec, events),
+    )
+    from rover.sim.env import CONTROL_FREQ
+
+    episode = Episode(
+        id=item.episode_id,
+        task=spec.description,
+        task_group=spec.group,
+        source=f"sim:{spec.name}",
+        fps=round(max(1.0, n * CONTROL_FREQ / max(len(roll), 1)), 3),
+        frame_indices=pos,
+        view_names=list(cfg.views),
+        default_view=cfg.views[0],
+        truth=truth,
+        extra={
+            "sim_task": spec.name,
+            "seed": cfg.seed,
+            "plan_index": item.index,
+            "demo": d,
+            "level_name": level.name,
+            "steps": len(roll),
+            "deviation": _deviation_summary(roll),
+        },
+        views=frames,
+    )
+    write_episode(out, episode)
+    return episode.id
+
+
+def _demo_seed(out: Path, task: str, d: int) -> int:
+    from rover.sim.demos import read_demos
+
+    return int(read_demos(out / "demos" / f"{task}.hdf5")[d].ep_meta.get("seed", 0))
+
+
+def _subtasks(spec: TaskSpec, sub_idx: np.ndarray) -> list[Subtask]:
+    out: list[Subtask] = []
+    prev_end = -1
+    for i, s in enumerate(spec.subtasks):
+        hits = np.nonzero(sub_idx == i)[0]
+        if len(hits) == 0:
+            continue
+        start = max(int(hits[0]), prev_end + 1)
+        end = int(hits[-1])
+        if end < start:
+            continue
+        out.append(Subtask(name=s.name, start=start, end=end, object=s.object))
+        prev_end = end
+    return out
+
+
+def _deviation_summary(roll) -> dict:
+    types = roll.state_type
+    return {
+        "terminated": bool(roll.terminated),
+        "non_expert_steps": int(sum(t == StateType.non_expert for t in types)),
+        "interpolating_steps": int(sum(t == StateType.interpolating for t in types)),
+        "expert_steps": int(sum(t == StateType.expert for t in types)),
+        "max_depth": int(roll.depth.max()) if len(roll.depth) else 0,
+    }
+
+
+# ----------------------------------------------------------- orchestration
+def _worker_init() -> None:
+    import logging
+
+    logging.getLogger("robosuite").setLevel(logging.ERROR)
+
+
+def _run_item(args: tuple[WorkItem, GenerateConfig, Path]) -> str:
+    return generate_episode(*args)
+
+
+def _run_demo(args: tuple[str, GenerateConfig, Path]) -> str:
+    make_demos(*args)
+    return args[0]
+
+
+def generate(
+    cfg: GenerateConfig,
+    out: Path,
+    workers: int = 1,
+    on_progress: Callable[[str, int, int], None] | None = None,
+) -> list[str]:
+    """Generate (or finish) a dataset in `out`; returns the ids written by this call.
+
+    Finished episodes already in `out` are kept; `.part` folders from an interrupted run
+    are redone. `on_progress(stage, done, total)` reports demos and episodes.
+    """
+    from rover.sim.render import check_views
+
+    check_views(cfg.views)
+    if cfg.frames is not None and not 1 <= cfg.frames <= MAX_FRAMES:
+        raise InputError(f"--frames must lie in 1..{MAX_FRAMES}, got {cfg.frames}")
+    for t in cfg.tasks:
+        get_task(t)
+    out = Path(out)
+    write_dataset_info(
+        out, DatasetInfo(name=out.name, views=list(cfg.views), generator=cfg.model_dump())
+    )
+    demo_dir = out / "demos"
+    done = set(episode_ids(out))
+    todo = [it for it in work_items(cfg) if it.episode_id not in done]
+    total = len(todo)
+    written: list[str] = []
+    report = on_progress or (lambda *_: None)
+    with _pool(workers) as pool:
+        tasks = sorted({it.task for it in todo})
+        for i, _ in enumerate(pool.imap_unordered(_run_demo, [(t, cfg, demo_dir) for t in tasks])):
+            report("demos", i + 1, len(tasks))
+        report("episodes", 0, total)
+        for eid in pool.imap_unordered(_run_item, [(it, cfg, out) for it in todo]):
+            written.append(eid)
+            report("episodes", len(written), total)
+    return sorted(written)
+
+
+class _Serial:
+    """In-process stand-in for a pool (workers=1: no spawn cost, easy to debug)."""
+
+    def __enter__(self) -> _Serial:
+        _worker_init()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+    def imap_unordered(self, fn, items) -> Iterator:
+        return map(fn, items)
+
+
+def _pool(workers: int):
+    if workers <= 1:
+        return _Serial()
+    ctx = mp.get_context("spawn")
+    return ctx.Pool(workers, initializer=_worker_init, maxtasksperchild=None)

@@ -1,0 +1,167 @@
+"""Trajectory levels: how much of the task a generated video gets done (paper App. B, Table 5).
+
+Table 5 orders videos of a task by the amount of the task completed: "fail to approach",
+"approach", "contact", "pick up", ..., up to full completion with near-expert behaviour.
+A `LevelSpec` turns one row into knobs for `rover.sim.perturb.plan_trajectory`: where the
+trajectory stops following the expert for good (a subtask and a fraction of it), how many
+recovered deviations it suffers before that, and how wild they are. Every range is sampled
+per video, so videos of one level differ in deviation times, counts, magnitudes, recovery
+points and recovery smoothness (Sec. 4.1, "we ensure diversity ...").
+"""
+
+from __future__ import annotations
+
+import zlib
+from collections.abc import Sequence
+
+import numpy as np
+from pydantic import BaseModel, Field, model_validator
+
+IntRange = tuple[int, int]
+FloatRange = tuple[float, float]
+
+
+class LevelSpec(BaseModel):
+    """One trajectory level of a task (one row of App. B, Table 5).
+
+    Ranges are inclusive ``(low, high)`` and sampled uniformly per video.
+
+    Attributes:
+        level: 1 = least of the task done; the highest level completes the task.
+        name: what the level shows, e.g. "Approach the can" (documentation and reports).
+        terminate_subtask: subtask index in which the video ends in a final, unrecovered
+            random deviation; None means the video follows the expert to the task's end.
+        terminate_at: fraction of that subtask's expert steps completed before the final
+            deviation starts (0 = at its first step, 1 = at its last step).
+        terminal_w: length (control steps) of the final, unrecovered deviation.
+        deviations: number of recovered deviations before the end.
+        w: length of each recovered deviation in control steps.
+        scale: magnitude of random actions as a fraction of the action range around its
+            centre (1.0 = uniform over the whole action space, as in the paper).
+        hold: a new random action is drawn every `hold` steps (1 = paper; larger values
+            give visibly larger excursions because per-step noise averages out).
+        h: recovery horizon: the recovery heads for expert state ``q + h``.
+        n_interp: interpolation steps of a recovery (smoothness).
+        nested_prob: probability that a recovery is interrupted by a nested deviation.
+    """
+
+    level: int = Field(ge=1)
+    name: str = ""
+    terminate_subtask: int | None = None
+    terminate_at: FloatRange = (0.0, 0.0)
+    terminal_w: IntRange = (20, 60)
+    deviations: IntRange = (0, 0)
+    w: IntRange = (5, 20)
+    scale: FloatRange = (0.5, 1.0)
+    hold: IntRange = (1, 6)
+    h: IntRange = (5, 25)
+    n_interp: IntRange = (5, 15)
+    nested_prob: float = Field(default=0.0, ge=0.0, le=1.0)
+
+    @model_validator(mode="after")
+    def _ranges_ordered(self) -> LevelSpec:
+        for field in ("terminate_at", "terminal_w", "deviations", "w", "scale", "hold"):
+            lo, hi = getattr(self, field)
+            if lo > hi or lo < 0:
+                raise ValueError(f"level {self.level}: {field} must be 0 <= low <= high")
+        for field in ("h", "n_interp"):
+            lo, hi = getattr(self, field)
+            if lo < 1 or lo > hi:
+                raise ValueError(f"level {self.level}: {field} must be 1 <= low <= high")
+        if self.terminate_at[1] > 1.0:
+            raise ValueError(f"level {self.level}: terminate_at must lie in [0, 1]")
+        if self.w[0] < 1 or self.terminal_w[0] < 1 or self.hold[0] < 1:
+            raise ValueError(f"level {self.level}: w, terminal_w and hold must be >= 1")
+        return self
+
+    @property
+    def completes(self) -> bool:
+        """Whether videos of this level follow the expert to the end of the task."""
+        return self.terminate_subtask is None
+
+
+def default_levels(milestones: Sequence[Sequence[str]]) -> list[LevelSpec]:
+    """Table-5-style levels from the milestones of each subtask.
+
+    Each subtask lists the milestones reached while doing it (e.g. grasp:
+    ["Approach the can", "Contact the can"]). Level 1 fails early in the first subtask;
+    each further level stops after one more milestone; the last level completes the task
+    with small recovered deviations (near-expert). A subtask with k milestones is cut at
+    fractions 1/(k+1), 2/(k+1), ... of its expert steps.
+
+    Args:
+        milestones: per subtask, the names of the milestones inside it, in order. The
+            final milestone of a subtask is its completion and need not be listed.
+
+    Returns:
+        Levels 1..L, L = 1 + sum(len(m) + 1 for m in milestones).
+    """
+    levels: list[LevelSpec] = [
+        LevelSpec(
+            level=1,
+            name="Fail to make progress",
+            terminate_subtask=0,
+            terminate_at=(0.0, 0.1),
+            terminal_w=(40, 80),
+            scale=(0.7, 1.0),
+        )
+    ]
+    for i, names in enumerate(milestones):
+        k = len(names)
+        cuts = [(m + 1) / (k + 1) for m in range(k)] + [None]
+        for m, cut in enumerate(cuts):
+            label = names[m] if m < k else f"Complete subtask {i + 1}"
+            last_subtask = i == len(milestones) - 1
+            if cut is None and last_subtask:
+                levels.append(
+                    LevelSpec(
+                        level=len(levels) + 1,
+                        name="Complete the task",
+                        deviations=(0, 2),
+                        w=(3, 10),
+                        scale=(0.2, 0.6),
+                        h=(3, 12),
+                        n_interp=(4, 10),
+                        nested_prob=0.2,
+                    )
+                )
+                continue
+            if cut is None:  # stop right at the start of the next subtask
+                sub, at = i + 1, (0.0, 0.05)
+            else:
+                sub, at = i, (max(cut - 0.1, 0.0), min(cut + 0.1, 1.0))
+            levels.append(
+                LevelSpec(
+                    level=len(levels) + 1,
+                    name=label,
+                    terminate_subtask=sub,
+                    terminate_at=at,
+                    deviations=(0, 2),
+                    nested_prob=0.3,
+                )
+            )
+    return levels
+
+
+def plan_seed(seed: int, task: str, index: int) -> np.random.Generator:
+    """The Generator for video ``index`` of ``task``: stable across runs and processes.
+
+    Python's ``hash`` of a string changes per process, so the task name enters through
+    CRC32 instead.
+    """
+    return np.random.default_rng([int(seed), zlib.crc32(task.encode("utf-8")), int(index)])
+
+
+def level_schedule(levels: Sequence[LevelSpec], per_level: int) -> list[tuple[int, LevelSpec]]:
+    """``(index, level)`` pairs for ``per_level`` videos of every level, lowest level first.
+
+    The index is the video's number within the task; feed it to `plan_seed` so each
+    video's plan is deterministic and independent of how many videos other levels get.
+    """
+    if per_level < 0:
+        raise ValueError(f"per_level must be >= 0, got {per_level}")
+    out: list[tuple[int, LevelSpec]] = []
+    for spec in sorted(levels, key=lambda s: s.level):
+        for k in range(per_level):
+            out.append((spec.level * 10_000 + k, spec))
+    return out

@@ -1,0 +1,115 @@
+"""Render saved simulator states to video frames, only the frames a video needs.
+
+Simulation runs without cameras; afterwards the generator picks the N states of the
+video and renders each view here with one `mujoco.Renderer` on the task's model and a
+private `MjData` (so rendering never disturbs the simulation). Views:
+
+- ``wrist``: robosuite's eye-in-hand camera on the Panda hand.
+- ``left`` / ``right``: free cameras looking at the workspace from the front-left and
+  front-right of the robot (no model edit needed, so robosuite/RoboCasa models load as is).
+- any camera name in the model (``frontview``, ``agentview``, ...) also works.
+
+Cost is geometry-bound on a CPU rasteriser, so multisampling is off, the offscreen buffer
+is sized to the frame, and shadows and reflections are off. `mujoco.Renderer` already
+returns images upright (row 0 is the top of the picture).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import mujoco  # noqa: E402
+
+from rover.errors import InputError  # noqa: E402
+
+WRIST_CAMERA = "robot0_eye_in_hand"
+
+
+@dataclass(frozen=True)
+class FreeView:
+    """A free camera: look at `lookat` from `distance` m, azimuth/elevation in degrees."""
+
+    lookat: tuple[float, float, float]
+    distance: float
+    azimuth: float
+    elevation: float
+
+
+# Workspace views for robosuite's table tasks (table top centre ~ (0, 0, 0.8); the robot
+# base stands at x ~ -0.56 looking along +x). Azimuth 180 would look from the front.
+FREE_VIEWS: dict[str, FreeView] = {
+    "left": FreeView(lookat=(0.0, 0.0, 0.95), distance=1.6, azimuth=-120.0, elevation=-28.0),
+    "right": FreeView(lookat=(0.0, 0.0, 0.95), distance=1.6, azimuth=120.0, elevation=-28.0),
+}
+VIEW_NAMES = ["wrist", "left", "right"]
+
+
+def check_views(views: list[str]) -> None:
+    """Raise a one-line InputError naming the valid views for an unknown one."""
+    for v in views:
+        if v not in VIEW_NAMES:
+            raise InputError(f"unknown view {v!r}; valid views: {', '.join(VIEW_NAMES)}")
+
+
+class StateRenderer:
+    """Renders flat robosuite states of one model from named views at one size."""
+
+    def __init__(self, model: mujoco.MjModel, width: int, height: int | None = None) -> None:
+        height = height or width
+        self.model = model
+        model.vis.quality.offsamples = 0
+        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+        self.data = mujoco.MjData(model)
+        self.renderer = mujoco.Renderer(model, height=height, width=width)
+        self.width, self.height = width, height
+        # robosuite puts collision geoms in group 0 and visual meshes in group 1: hide 0
+        self.option = mujoco.MjvOption()
+        self.option.geomgroup[0] = 0
+
+    def camera(self, view: str, lookat: np.ndarray | None = None) -> mujoco.MjvCamera | int:
+        if view == "wrist":
+            view = WRIST_CAMERA
+        if view in FREE_VIEWS:
+            fv = FREE_VIEWS[view]
+            cam = mujoco.MjvCamera()
+            cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+            cam.lookat[:] = fv.lookat if lookat is None else lookat
+            cam.distance, cam.azimuth, cam.elevation = fv.distance, fv.azimuth, fv.elevation
+            return cam
+        cid = int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, view))
+        if cid < 0:
+            raise InputError(f"unknown view {view!r}; valid views: {', '.join(VIEW_NAMES)}")
+        return cid
+
+    def set_state(self, state: np.ndarray) -> None:
+        """Pose the private MjData from a flat ``[time, qpos, qvel]`` state."""
+        m, d = self.model, self.data
+        d.time = state[0]
+        d.qpos[:] = state[1 : 1 + m.nq]
+        d.qvel[:] = state[1 + m.nq : 1 + m.nq + m.nv]
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_camlight(m, d)
+
+    def render(self, states: np.ndarray, views: list[str]) -> dict[str, np.ndarray]:
+        """Frames (T, H, W, 3) uint8 per view for each state in order."""
+        check_views(views)
+        cams = {v: self.camera(v) for v in views}
+        out = {v: np.empty((len(states), self.height, self.width, 3), np.uint8) for v in views}
+        for t, state in enumerate(states):
+            self.set_state(np.asarray(state, dtype=np.float64))
+            for v, cam in cams.items():
+                self.renderer.update_scene(self.data, camera=cam, scene_option=self.option)
+                scn = self.renderer.scene
+                scn.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+                scn.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+                out[v][t] = self.renderer.render()
+        return out
+
+    def close(self) -> None:
+        self.renderer.close()

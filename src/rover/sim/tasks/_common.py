@@ -1,0 +1,79 @@
+"""Building blocks shared by the task spec files: fingers, levels, QA wordings."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from rover.sim.levels import LevelSpec, default_levels
+from rover.sim.tasks.base import QATemplate, SubtaskSpec
+
+FINGERS = ["left_finger", "right_finger"]
+
+
+def grasp_subtask(name: str, obj: str, point: str | None = None, signal: str = "") -> SubtaskSpec:
+    """Bring both fingers to the object (no goal term): "pick up the can"."""
+    where = point or obj
+    return SubtaskSpec(
+        name=name,
+        object=obj,
+        robot_points=FINGERS,
+        object_points=[where, where],
+        goal=None,
+        beta=0.0,
+        end_signal=signal or f"lifted:{obj}",
+    )
+
+
+def move_subtask(
+    name: str, obj: str, goal: str, signal: str, beta: float = 0.8, point: str | None = None
+) -> SubtaskSpec:
+    """Carry the object to a goal point, mostly measured by the object-goal distance."""
+    where = point or obj
+    return SubtaskSpec(
+        name=name,
+        object=obj,
+        robot_points=FINGERS,
+        object_points=[where, where],
+        goal=goal,
+        beta=beta,
+        end_signal=signal,
+    )
+
+
+def named_levels(milestones: Sequence[Sequence[str]], names: Sequence[str]) -> list[LevelSpec]:
+    """B's default Table-5 levels, relabelled with this task's wording."""
+    levels = default_levels(milestones)
+    if len(names) != len(levels):
+        raise ValueError(f"{len(names)} level names for {len(levels)} levels")
+    return [lv.model_copy(update={"name": n}) for lv, n in zip(levels, names, strict=True)]
+
+
+def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
+    """App. B Table 5, pick-and-place group: seven levels."""
+    return named_levels(
+        [[f"Approach the {obj}", f"Contact the {obj}"], [f"Keep grasp of the {obj}",
+          f"Approach placing the {obj} {target}"]],
+        [
+            f"Fail to approach the {obj}",
+            f"Approach the {obj}",
+            f"Contact the {obj}",
+            f"Pick up the {obj}",
+            f"Keep grasp of the {obj}",
+            f"Approach placing the {obj} {target}",
+            f"Place the {obj} {target}",
+        ],
+    )
+
+
+def pick_place_qa(obj: str, target: str) -> list[QATemplate]:
+    """App. C.3 pick-and-place questions for one object."""
+    return [
+        QATemplate(id="did_contact", text=f"Did the robot contact the {obj}? If so, when?",
+                   event="contact", object=obj),
+        QATemplate(id="did_pick_up", text=f"Did the robot pick up the {obj}? If so, when?",
+                   event="pick_up", object=obj),
+        QATemplate(id="did_drop", text=f"Did the robot drop the {obj}? If so, when?",
+                   event="drop", object=obj),
+        QATemplate(id="did_place", text=f"Did the robot place the {obj} {target}? If so, when?",
+                   event="place", object=obj, target=target),
+    ]
