@@ -27,8 +27,17 @@ def test_group_mean_se() -> None:
 
 
 @pytest.mark.parametrize(
-    ("n", "label"), [(1, "0-10"), (3, "0-10"), (10, "0-10"), (11, "10-20"), (30, "20-30"),
-                     (31, "30-40"), (0, None), (None, None)]
+    ("n", "label"),
+    [
+        (1, "0-10"),
+        (3, "0-10"),
+        (10, "0-10"),
+        (11, "10-20"),
+        (30, "20-30"),
+        (31, "30-40"),
+        (0, None),
+        (None, None),
+    ],
 )
 def test_context_bins(n, label) -> None:
     assert context_bin(n) == label
@@ -46,16 +55,27 @@ def test_nonexpert_share_and_bins(make_episode) -> None:
 
 def test_context_frames_from_first_call_showing_each_frame() -> None:
     # TemporalConcat-like: call t shows frames 0..t
-    calls = [CallRecord(id=t, kind="concat.frame", frame_indices=list(range(t + 1)))
-             for t in range(4)]
-    tr = Trace(method="m", backend="b", model="x", episode_id="e", task="t", num_frames=4,
-               frame_indices=[0, 1, 2, 3], calls=calls,
-               frames=[FrameRecord(index=i, position=i) for i in range(4)])
+    calls = [
+        CallRecord(id=t, kind="concat.frame", frame_indices=list(range(t + 1))) for t in range(4)
+    ]
+    tr = Trace(
+        method="m",
+        backend="b",
+        model="x",
+        episode_id="e",
+        task="t",
+        num_frames=4,
+        frame_indices=[0, 1, 2, 3],
+        calls=calls,
+        frames=[FrameRecord(index=i, position=i) for i in range(4)],
+    )
     assert context_frames(tr) == {0: 1, 1: 2, 2: 3, 3: 4}
     # ROVER-like: [line start, previous, current] -> 3 frames once the window is full
-    calls = [CallRecord(id=0, kind="rover.step", frame_indices=[0]),
-             CallRecord(id=1, kind="rover.step", frame_indices=[0, 1]),
-             CallRecord(id=2, kind="rover.step", frame_indices=[0, 1, 2]),
-             CallRecord(id=3, kind="rover.step", frame_indices=[0, 2, 3])]
+    calls = [
+        CallRecord(id=0, kind="rover.step", frame_indices=[0]),
+        CallRecord(id=1, kind="rover.step", frame_indices=[0, 1]),
+        CallRecord(id=2, kind="rover.step", frame_indices=[0, 1, 2]),
+        CallRecord(id=3, kind="rover.step", frame_indices=[0, 2, 3]),
+    ]
     tr = tr.model_copy(update={"calls": calls})
     assert context_frames(tr) == {0: 1, 1: 2, 2: 3, 3: 3}

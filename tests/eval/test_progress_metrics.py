@@ -13,10 +13,17 @@ from rover.methods.trace import FrameRecord, Trace
 
 def _trace(indices: list[int], progress: list[float | None], episode_id: str = "ep0") -> Trace:
     return Trace(
-        method="m", backend="b", model="x", episode_id=episode_id, task="t",
-        num_frames=len(indices), frame_indices=indices,
-        frames=[FrameRecord(index=i, position=p, progress=v)
-                for p, (i, v) in enumerate(zip(indices, progress, strict=True))],
+        method="m",
+        backend="b",
+        model="x",
+        episode_id=episode_id,
+        task="t",
+        num_frames=len(indices),
+        frame_indices=indices,
+        frames=[
+            FrameRecord(index=i, position=p, progress=v)
+            for p, (i, v) in enumerate(zip(indices, progress, strict=True))
+        ],
     )
 
 

@@ -109,3 +109,16 @@ def test_reason_errors_are_one_line(tmp_path, clip):
     assert "Traceback" not in res.stderr and len(res.stderr.strip().splitlines()) == 1
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
     assert res.returncode == 2 and "pass --task" in res.stderr
+
+
+def test_replayed_oracle_stays_labelled(tmp_path, make_episode):
+    ep_dir = write_episode(tmp_path / "ds", make_episode(10, size=64))
+    cassette, out = tmp_path / "oracle.jsonl", tmp_path / "r.json"
+    base = ["reason", str(ep_dir), "--method", "rover", "--out", str(out)]
+    assert CliRunner().invoke(app, [*base, "--record", str(cassette)]).exit_code == 0
+    recorded = Trace.load(out)
+    res = CliRunner().invoke(app, [*base, "--backend", f"replay:{cassette}"])
+    assert res.exit_code == 0, res.output
+    replayed = Trace.load(out)
+    assert replayed.backend == "replay" and replayed.oracle and "ORACLE" in res.output
+    assert replayed.progress() == recorded.progress()

@@ -75,13 +75,21 @@ def _check_oracle_labels(page: str) -> None:
     assert page.count('class="badge oracle"') >= 4 + 3 * 3
 
 
-def test_no_oracle_banner_for_other_backends(make_run, tmp_path: Path) -> None:
-    index = build_report(make_run(backend="replay", name="r"), tmp_path / "r")
+def test_report_command_without_oracle(make_run, tmp_path: Path) -> None:
+    """`rover report` on a non-oracle run: written where asked, and no oracle labels."""
+    run = make_run(backend="replay", name="r")
+    out = tmp_path / "cli-report"
+    result = CliRunner().invoke(app, ["report", str(run), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    index = out / "index.html"
+    assert str(index) in result.output
     page = index.read_text()
     assert "ORACLE" not in page
     assert "replay:replay" in page
     svg = (index.parent / "figures" / "pearson_by_group_level.svg").read_text()
     assert "ORACLE" not in svg
+    bad = CliRunner().invoke(app, ["report", str(tmp_path / "missing")])
+    assert bad.exit_code != 0
 
 
 def _check_viewer(index: Path, page: str) -> None:
@@ -114,14 +122,3 @@ def test_missing_run_dir_is_an_input_error(tmp_path: Path) -> None:
     (tmp_path / "empty").mkdir()
     with pytest.raises(InputError, match="no traces"):
         build_report(tmp_path / "empty")
-
-
-def test_report_command(make_run, tmp_path: Path) -> None:
-    run = make_run()
-    out = tmp_path / "cli-report"
-    result = CliRunner().invoke(app, ["report", str(run), "--out", str(out)])
-    assert result.exit_code == 0, result.output
-    assert (out / "index.html").exists()
-    assert "index.html" in result.output
-    bad = CliRunner().invoke(app, ["report", str(tmp_path / "missing")])
-    assert bad.exit_code != 0

@@ -325,3 +325,24 @@ def test_point_tracks_restores_state(demo):
     np.testing.assert_array_equal(sim.get_state(), states[3])
     assert tr.entities.shape == (5, 2, 3)
     np.testing.assert_allclose(tr.points["cube"][0], CUBE0)
+
+
+@pytest.mark.parametrize(
+    "expert_len, bounds", [(1, [(0, 0)]), (3, [(0, 0), (1, 2)]), (40, [(0, 9), (10, 29), (30, 39)])]
+)
+def test_any_plan_executes_consistently(expert_len, bounds):
+    """Planned lengths match, q never decreases, starts on the expert, completes on it."""
+    states = np.tile(PointMass().get_state(), (expert_len, 1))
+    states[:, 1] += 0.01 * np.arange(expert_len)
+    actions = np.zeros((expert_len, 4))
+    milestones = [["a"]] * len(bounds)
+    wild = LevelSpec(level=99, deviations=(4, 8), nested_prob=1.0, h=(1, 3), n_interp=(1, 4))
+    for level in [*default_levels(milestones), wild]:
+        for seed in range(3):
+            plan = plan_trajectory(expert_len, bounds, level, np.random.default_rng(seed))
+            r = execute_plan(PointMass(), states, actions, plan, np.random.default_rng(seed))
+            assert len(r) == plan.num_steps
+            assert r.q[0] == 0 and r.state_type[0] == StateType.expert
+            assert np.all(np.diff(r.q) >= 0) and r.q.max() <= expert_len - 1
+            if not plan.terminated:
+                assert r.q[-1] == expert_len - 1 and r.state_type[-1] == StateType.expert

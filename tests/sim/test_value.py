@@ -174,3 +174,29 @@ def test_rollout_jumping_into_next_subtask_gets_expert_value_there():
     idx = np.array([0, 1, 8, 9, 10])  # a recovery landing on expert state 8
     p = progress_from_tracks(expert.take(idx), idx, expert, SUBTASKS, bounds)
     np.testing.assert_allclose(p, full[idx])
+
+
+def test_chained_u_keeps_expert_monotone_over_a_keypoint():
+    """Lift an object over an obstacle: y peaks at the top (a keypoint)."""
+    up = [(0, 0, z) for z in np.linspace(0, 1, 6)]
+    over = [(x, 0, 1) for x in np.linspace(0.4, 2, 5)]
+    down = [(2, 0, z) for z in np.linspace(0.8, 0, 5)]
+    obj = np.array(up + over + down, dtype=float)
+    n = len(obj)
+    tracks = Tracks(
+        points={"eef": obj, "box": obj, "goal:g": np.tile([2.0, 0, 0], (n, 1))},
+        entities=np.stack([obj, obj], axis=1),
+    )
+    sub = [
+        SimpleNamespace(
+            object="box", robot_points=["eef"], object_points=["box"], goal="goal:g", beta=1.0
+        )
+    ]
+    y = goal_distance(obj[:, None], obj[:, None], obj, tracks.points["goal:g"], 1.0)
+    np.testing.assert_array_equal(keypoints(y), [5])  # the top of the lift
+    q = np.arange(n)
+    chained = progress_from_tracks(tracks, q, tracks, sub, [(0, n - 1)])
+    plain = progress_from_tracks(tracks, q, tracks, sub, [(0, n - 1)], chain_keypoints=False)
+    assert chained[-1] == pytest.approx(1.0) and plain[-1] == pytest.approx(1.0)
+    assert np.diff(chained).min() >= -1e-9
+    assert np.diff(plain).min() < -0.1  # the paper's u jumps when q passes the keypoint

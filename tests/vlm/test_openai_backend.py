@@ -182,3 +182,15 @@ def test_unreported_usage_is_estimated(openai_server, fast_config, make_prompt):
     assert usage.source == "estimated"
     assert usage.image_tokens == 2 * 255  # 64x48 -> one 512 tile at high detail (auto)
     assert usage.completion_tokens > 0
+
+
+def test_dead_endpoint_is_one_clear_line(fast_config, make_prompt):
+    import socket
+
+    with socket.socket() as s:  # a port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    config = fast_config.model_copy(update={"max_retries": 1})
+    vlm = load_vlm(f"openai:m@http://127.0.0.1:{port}/v1", config)
+    with pytest.raises(BackendError, match=f"cannot connect to http://127.0.0.1:{port}/v1"):
+        run(vlm.complete(make_prompt()))

@@ -55,6 +55,8 @@ def test_scrub_removes_known_and_key_shaped_strings():
     out = scrub(text)
     assert "custom-token-value-42" not in out and "sk-proj" not in out and "AIza" not in out
     assert out.count(REDACTED) == 3
+    ordinary = "subtask-completion-percentage and mask-rcnn-features stay as they are"
+    assert scrub(ordinary) == ordinary
 
 
 def test_log_filter_rewrites_records():

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich import box
 from rich.console import Console
 from rich.table import Table
 
@@ -83,8 +84,8 @@ def demo(
     if failed:
         console.print(f"[yellow]{failed} work units failed; see {run_dir / 'errors.jsonl'}[/]")
     console.print(f"done in {time.monotonic() - started:.0f} s")
-    console.print(f"report: {index}")
-    console.print(f"open it: {index.resolve().as_uri()}")
+    console.print(f"report: {index}", soft_wrap=True)
+    console.print(f"open it: {index.resolve().as_uri()}", soft_wrap=True)
 
 
 def _methods(text: str | None) -> list[str]:
@@ -158,17 +159,15 @@ def _table(run_dir: Path) -> Table:
     from rover.report.scores import mean_se, score_run, variants_in_order
 
     rows = score_run(load_run(run_dir))
-    table = Table(title=f"{ORACLE_LINE} (noisy oracle)", title_style="bold red")
-    for col in (
-        "method",
-        "Pearson r",
-        "L2",
-        "error rate %",
-        "QA acc. %",
-        "tokens/video",
-        "calls/video",
-    ):
-        table.add_column(col, justify="left" if col == "method" else "right")
+    table = Table(
+        box=box.SIMPLE_HEAD,
+        title="ORACLE OUTPUT (noisy oracle, not a VLM): mean per video",
+        title_style="bold red",
+        caption="r: Pearson with ground truth; err %: frames judged false; QA %: accuracy",
+    )
+    table.add_column("method", no_wrap=True, min_width=20)
+    for col in ("r", "L2", "err %", "QA %", "tokens", "calls"):
+        table.add_column(col, justify="right")
     for v in variants_in_order(rows):
         mine = [r for r in rows if r.variant == v]
 

@@ -33,5 +33,5 @@ def report(
     console = Console(highlight=False)
     with console.status("building report"):
         index = build_report(run_dir, out, dataset=dataset, max_episodes=max_episodes)
-    console.print(f"report: {index}")
-    console.print(f"open it: {index.resolve().as_uri()}")
+    console.print(f"report: {index}", soft_wrap=True)
+    console.print(f"open it: {index.resolve().as_uri()}", soft_wrap=True)

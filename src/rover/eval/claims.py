@@ -149,7 +149,8 @@ _PATTERNS: list[tuple[ClaimKind, re.Pattern[str]]] = [
     (
         "pressed",
         re.compile(
-            rf"\bthe\s+{_NP}\s+(?:is|has\s+been|was)\s+{_NEG}(?:now\s+)?(?:pressed|pushed|depressed)\b"
+            rf"\bthe\s+{_NP}\s+(?:is|was|has\s+(?:not\s+|never\s+)?been)\s+{_NEG}(?:now\s+)?"
+            rf"(?:pressed|pushed|depressed)\b"
             rf"|\b(?:robot|gripper|it)\s+(?:has\s+)?{_NEG.replace('neg', 'neg2')}"
             rf"(?:pressed|pushed|presses|pushes)\s+the\s+{_OBJ.replace('obj', 'np2')}",
             re.I,
@@ -166,12 +167,14 @@ _PATTERNS: list[tuple[ClaimKind, re.Pattern[str]]] = [
     ),
 ]
 
+_NOT_BEEN = re.compile(r"\b(?:not|never)\s+been\b")
 _SENTENCE = re.compile(r"(?<=[.!?;])\s+|\n+")
 
 
 def _neg(m: re.Match[str]) -> bool:
     g = m.groupdict()
-    return bool(g.get("neg") or g.get("neg2")) or "n't" in m.group(0).lower()
+    text = m.group(0).lower()
+    return bool(g.get("neg") or g.get("neg2")) or "n't" in text or bool(_NOT_BEEN.search(text))
 
 
 def _np(m: re.Match[str]) -> str | None:

@@ -89,11 +89,29 @@ def episode_refs(opts: EvalOptions) -> list[EpisodeRef]:
         refs = dataset_refs(opts.dataset, opts.episodes, opts.seed)
     else:
         refs = source_refs(opts.sources, opts.episodes, opts.seed)
+    if opts.dataset is not None:
+        _check_views(opts, refs)
     if opts.limit is not None:
         if opts.limit <= 0:
             raise InputError(f"--limit must be positive, got {opts.limit}")
         refs = refs[: opts.limit]
     return refs
+
+
+def _check_views(opts: EvalOptions, refs: list[EpisodeRef]) -> None:
+    """Unknown --views fail up front (one line), not as one error per episode."""
+    from rover.io.dataset import read_dataset_info, read_episode
+
+    wanted = [v for v in opts.views if v]
+    if not wanted or not refs:
+        return
+    known = set(read_dataset_info(opts.dataset).views)
+    known |= set(read_episode(opts.dataset, refs[0].source_id, load_frames=False).view_names)
+    for v in wanted:
+        if v not in known:
+            raise InputError(
+                f"--views: no view {v!r} in {opts.dataset}; views: {', '.join(sorted(known))}"
+            )
 
 
 def check_methods(methods: list[str]) -> None:

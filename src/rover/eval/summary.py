@@ -42,13 +42,19 @@ def _agg_index(metrics: dict[str, Any]) -> dict[tuple, dict[str, Any]]:
     }
 
 
-COMPACT = ("Pearson r", "L2", "VOC", "Error rate", "Success rate", "QA acc.", "Tokens/video",
-           "Calls/video")
+COMPACT = (
+    "Pearson r",
+    "L2",
+    "VOC",
+    "Error rate",
+    "Success rate",
+    "QA acc.",
+    "Tokens/video",
+    "Calls/video",
+)
 
 
-def main_rows(
-    metrics: dict[str, Any], compact: bool = False
-) -> tuple[list[str], list[list[str]]]:
+def main_rows(metrics: dict[str, Any], compact: bool = False) -> tuple[list[str], list[list[str]]]:
     """(headers, rows) of the main table: one row per variant (compact: for terminals)."""
     idx = _agg_index(metrics)
     qa = {(q["variant"]): q for q in metrics.get("qa_pooled", []) if q["by"] == "all"}

@@ -70,12 +70,13 @@ class Session:
         self.frames = episode.frames()
         self.encoding: ImageEncoding = getattr(vlm, "image_encoding", None) or ImageEncoding()
         self._parts: dict[int, ImagePart] = {}
+        self.lines_started = 0  # ROVER: ids for lines of reasoning
         self.trace = Trace(
             method=method.name,
             params=dict(method.params),
             backend=vlm.backend,
             model=vlm.model,
-            oracle=vlm.backend == "oracle",
+            oracle=is_oracle(vlm),
             episode_id=episode.id,
             task=episode.task,
             view=episode.view,
@@ -130,7 +131,7 @@ class Session:
         if usable(parsed):
             self._record(prompt, completion, "ok", line_id)
             return parsed, True
-        first = self._record(prompt, completion, "retried", line_id)
+        self._record(prompt, completion, "retried", line_id)
         retry = Prompt(
             messages=[
                 *messages,
@@ -142,8 +143,8 @@ class Session:
         completion2 = await self._complete(retry)
         parsed2 = parse(completion2.text)
         ok = usable(parsed2)
-        rec = self._record(retry, completion2, "ok" if ok else "failed", line_id)
-        del first, rec  # both calls are in the trace: "retried", then "ok" or "failed"
+        # both calls stay in the trace: the first as "retried", this one "ok" or "failed"
+        self._record(retry, completion2, "ok" if ok else "failed", line_id)
         return parsed2, ok
 
     async def _complete(self, prompt: Prompt) -> Completion:
@@ -200,6 +201,14 @@ class Session:
         self.trace.totals = self.trace.compute_totals()
         self.trace.finished_at = datetime.now(UTC).isoformat()
         return self.trace
+
+
+def is_oracle(vlm: VLM) -> bool:
+    """Oracle answers stay labelled, also when replayed from a cassette the oracle recorded."""
+    if vlm.backend == "oracle":
+        return True
+    recorded = getattr(vlm, "recorded_models", None)
+    return vlm.backend == "replay" and recorded == ["ground-truth"]
 
 
 def text(s: str) -> TextPart:

@@ -32,7 +32,7 @@ class TemporalConcat(Method):
     name = "temporal-concat"
     local: int | None = None  # frames kept per call (None: all so far)
 
-    def __init__(self, concurrency: int = 4, **_ignored: Any) -> None:
+    def __init__(self, concurrency: int = 8, **_ignored: Any) -> None:
         super().__init__()
         self.concurrency = int(concurrency)
 

@@ -77,7 +77,7 @@ class GVL(Method):
     name = "gvl"
     per_timestep = True
 
-    def __init__(self, seed: int = 0, concurrency: int = 4, **_ignored: Any) -> None:
+    def __init__(self, seed: int = 0, concurrency: int = 8, **_ignored: Any) -> None:
         super().__init__(seed=int(seed))
         self.seed = int(seed)
         self.concurrency = int(concurrency)

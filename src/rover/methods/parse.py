@@ -15,11 +15,6 @@ import re
 from dataclasses import dataclass, field
 
 _NUM = r"[-+−–]?\s*\d+(?:[.,]\d+)?"
-_PCT_LABEL = re.compile(
-    r"(?:sub\s*-?\s*task|task)?\s*(?:completion|progress|complete)\s*(?:percentage|percent|%|value)?"
-    r"|percentage|progress",
-    re.I,
-)
 _NEEDS_TO = re.compile(r"the\s+robot\s+needs\s+to\s*[:\-–]?\s*(.*)", re.I)
 _PLAN = re.compile(r"new\s+sub\s*-?\s*tasks?\s*[:\-–]\s*(.*)", re.I)
 _DESC = re.compile(r"frame\s+description\s*[:\-–=]\s*(.*)", re.I)
@@ -32,6 +27,9 @@ _NEXT = re.compile(r"\[\s*next[\s_-]*frame\s*\]", re.I)
 _COMPLETE = re.compile(r"\b(?:task|subtask)\s+(?:is\s+)?(?:now\s+)?complete(?:d)?\b", re.I)
 _FRAME_HEADER = re.compile(r"^\W*frame\s*#?\s*(\d+)\s*(?:\W|$)(.*)$", re.I)
 _NUMBER = re.compile(_NUM)
+# the well-formed block, parsed without the general machinery (GVL replies hold hundreds)
+_FAST_DESC = re.compile(r"frame\s+description\s*:\s*(.+)", re.I)
+_FAST_PCT = re.compile(rf"completion\s+percentage\s*:\s*({_NUM})\s*%", re.I)
 
 
 @dataclass
@@ -232,7 +230,12 @@ def parse_frames(text: object) -> dict[int, FrameAnswer]:
     def flush() -> None:
         if current is None:
             return
-        ans = parse_frame("\n".join(block))
+        body = "\n".join(block)
+        d, p = _FAST_DESC.search(body), _FAST_PCT.search(body)
+        if d and p and d.end() <= p.start():
+            ans = FrameAnswer(d.group(1).strip() or None, parse_percentage(p.group(1)))
+        else:
+            ans = parse_frame(body)
         prev = out.get(current)
         if prev is None or (prev.progress is None and ans.progress is not None):
             out[current] = ans

@@ -100,9 +100,7 @@ class Rover(Method):
 
     async def run(self, episode: Episode, vlm: VLM, on_step: OnStep | None = None) -> Trace:
         vlm = vlm.bind(episode)
-        s = Session(self, episode, vlm, on_step)
-        self._lines = 0
-        self._indices = list(episode.frame_indices)
+        s = Session(self, episode, vlm, on_step)  # all per-run state lives on s
         # ROVER(c, []) with c = task description + first observation (Sec. 3)
         root = self._new_line(s, episode.task, [], 0, Seen(0, None, 0.0))
         await self._line(s, root)
@@ -119,13 +117,13 @@ class Rover(Method):
         self, s: Session, subtask: str, path: list[str], depth: int, first: Seen
     ) -> _Line:
         node = LineNode(
-            id=self._lines,
+            id=s.lines_started,
             subtask=subtask,
             depth=depth,
             first_frame=s.episode.frame_indices[first.position],
             first_position=first.position,
         )
-        self._lines += 1
+        s.lines_started += 1
         return _Line(
             id=node.id,
             subtask=subtask,
@@ -147,7 +145,7 @@ class Rover(Method):
         t = line.first.position if line.first.description is None else line.first.position + 1
         while True:  # Alg. 1 line 2
             if t >= s.num_frames:  # end of the video ends every open line
-                return self._end(line, "end_of_video")
+                return self._end(s, line, "end_of_video")
             reply, ok = await self._step(s, line, t)  # line 3: Y = Y + Θ(c + Y)
             fr = s.trace.frames[t]
             if reply.description:
@@ -166,6 +164,7 @@ class Rover(Method):
                     line.node.planned_subtasks = list(reply.plan)
                     line.stitch.planned = max(line.stitch.planned, len(reply.plan))
                 anchor = Seen(t, reply.description or line.last_description, 0.0)
+                s.step(t, [*line.path, reply.new_subtask], None)
                 child = await self._child(s, line, reply.new_subtask, anchor)  # line 7
                 nxt = await self._after_children(s, line, child)
                 if nxt is None:
@@ -174,12 +173,12 @@ class Rover(Method):
             elif reply.progress is not None:  # line 4: [next-frame]
                 self._record(s, line, t, reply)
                 if reply.progress >= self.threshold:  # line 8: subtask complete
-                    return self._end(line, "complete")
+                    return self._end(s, line, "complete")
                 t += 1  # line 5: Y = Window(Y + o_next)
             else:  # line 8: "Task complete"
                 reply.progress = 100.0
                 self._record(s, line, t, reply)
-                return self._end(line, "complete")  # line 9
+                return self._end(s, line, "complete")  # line 9
 
     async def _child(self, s: Session, parent: _Line, subtask: str, anchor: Seen) -> _Line:
         """φ(Y) -> ROVER(φ(Y), []) -> the ended child, whose final frame ψ returns."""
@@ -202,7 +201,7 @@ class Rover(Method):
             line.last_position = child.last_position
             line.last_description = child.last_description
             if child.node.outcome == "end_of_video" or child.last_position >= s.num_frames - 1:
-                return self._end_none(line, "end_of_video")
+                return self._end_none(s, line, "end_of_video")
             reply, ok = await self._parent_turn(s, line, child)
             f = child.last_position
             want_more = ok and reply.new_subtask is not None
@@ -210,7 +209,7 @@ class Rover(Method):
                 want_more, reply.new_subtask = True, line.plan[len(line.completed)]
             if want_more and reply.new_subtask:
                 if len(line.node.children) >= self.max_subtasks:
-                    return self._end_none(line, "guard")
+                    return self._end_none(s, line, "guard")
                 anchor = Seen(f, child.last_description, 0.0)
                 child = await self._child(s, line, reply.new_subtask, anchor)
                 continue
@@ -218,20 +217,20 @@ class Rover(Method):
                 line.last_position = f
                 self._record(s, line, f, reply, overwrite=False)
                 if reply.progress >= self.threshold:
-                    return self._end_none(line, "complete")
+                    return self._end_none(s, line, "complete")
             elif ok:  # "Task complete"
-                return self._end_none(line, "complete")
+                return self._end_none(s, line, "complete")
             return f + 1  # carry on frame by frame in this line
 
-    def _end(self, line: _Line, outcome: str) -> _Line:
+    def _end(self, s: Session, line: _Line, outcome: str) -> _Line:
         line.node.outcome = outcome  # type: ignore[assignment]
         line.node.last_position = line.last_position
-        line.node.last_frame = self._indices[line.last_position]
+        line.node.last_frame = s.episode.frame_indices[line.last_position]
         line.node.final_description = line.last_description
         return line
 
-    def _end_none(self, line: _Line, outcome: str) -> None:
-        self._end(line, outcome)
+    def _end_none(self, s: Session, line: _Line, outcome: str) -> None:
+        self._end(s, line, outcome)
         return None
 
     def _record(self, s: Session, line: _Line, t: int, reply: StepReply, overwrite: bool = True):

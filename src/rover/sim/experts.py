@@ -22,6 +22,7 @@ from rover.sim.env import SimEnv
 OPEN, CLOSE = -1.0, 1.0
 POS_SCALE = 0.05  # m per unit action (robosuite OSC_POSE output_max)
 ROT_SCALE = 0.5  # rad per unit action
+ROT_TOL = 0.08  # rad: a waypoint counts as reached only once the hand is turned too
 
 
 @dataclass
@@ -69,14 +70,16 @@ class Scripted:
         self.states: list[np.ndarray] = []
         self.actions: list[np.ndarray] = []
 
-    def action(self, target: np.ndarray, grip: float, yaw: float, gain: float) -> np.ndarray:
-        sim = self.sim
-        err = target - sim.point("eef")
-        pos = np.clip(gain * err / POS_SCALE, -1.0, 1.0)
-        cur = sim.data.site_xmat[sim._eef_site].reshape(3, 3)
+    def rot_error(self, yaw: float) -> np.ndarray:
+        """Axis-angle (world frame) from the current hand orientation to the wanted one."""
+        cur = self.sim.data.site_xmat[self.sim._eef_site].reshape(3, 3)
         want = Rotation.from_euler("zx", [yaw, self.tilt]).as_matrix() @ self.down
-        rotvec = Rotation.from_matrix(want @ cur.T).as_rotvec()
-        rot = np.clip(rotvec / ROT_SCALE, -1.0, 1.0)
+        return Rotation.from_matrix(want @ cur.T).as_rotvec()
+
+    def action(self, target: np.ndarray, grip: float, yaw: float, gain: float) -> np.ndarray:
+        err = target - self.sim.point("eef")
+        pos = np.clip(gain * err / POS_SCALE, -1.0, 1.0)
+        rot = np.clip(self.rot_error(yaw) / ROT_SCALE, -1.0, 1.0)
         return np.concatenate([pos, rot, [grip]])
 
     def run(self, phase: Phase) -> None:
@@ -92,6 +95,7 @@ class Scripted:
                 phase.tol is not None
                 and k >= phase.min_steps
                 and np.linalg.norm(target - self.sim.point("eef")) < phase.tol
+                and np.linalg.norm(self.rot_error(yaw)) < ROT_TOL
             ):
                 return
             act = self.action(target, phase.grip, yaw, phase.gain)
@@ -100,11 +104,15 @@ class Scripted:
             self.sim.step(act)
 
 
-def grasp_yaw(sim: SimEnv, obj: str, period: float) -> float:
-    """Gripper yaw that lines the fingers up with the object's faces (mod `period`)."""
+def grasp_yaw(sim: SimEnv, obj: str, period: float, offset: float = 0.0) -> float:
+    """Gripper yaw that lines the fingers up with the object's faces (mod `period`).
+
+    At yaw 0 the fingers close along world y; `offset` turns them to pinch across the
+    object's x extent instead (a cereal box is only thin along x).
+    """
     spec = sim.spec.object_spec(obj)
     mat = sim.data.xmat[sim._body_id(spec.body)].reshape(3, 3)
-    return _wrap(_yaw_of(mat), period)
+    return _wrap(_yaw_of(mat) + offset, period)
 
 
 def pick_phases(
@@ -114,12 +122,13 @@ def pick_phases(
     where = point or obj
 
     def above() -> np.ndarray:
-        return sim.point(where) + np.array([0, 0, 0.10])
+        return sim.point(where) + np.array([0, 0, 0.10 + grasp_dz])
 
     def at() -> np.ndarray:
         return sim.point(where) + np.array([0, 0, grasp_dz])
 
-    yaw = (lambda: grasp_yaw(sim, obj, period)) if period else (lambda: 0.0)
+    turn = _YAW_OFFSET.get(obj, 0.0)
+    yaw = (lambda: grasp_yaw(sim, obj, period, turn)) if period else (lambda: 0.0)
     hold = [None]
 
     def here() -> np.ndarray:
@@ -169,12 +178,17 @@ _PERIOD = {"cube": np.pi / 2, "red cube": np.pi / 2, "can": None, "milk": np.pi 
            "bread": np.pi, "cereal": np.pi}
 
 
+# tall objects: grasp this far above their centre so the palm clears their top (m)
+_GRASP_DZ = {"milk": 0.045, "cereal": 0.04}
+_YAW_OFFSET = {"cereal": np.pi / 2}
+
+
 def _pick_place_script(sim: SimEnv) -> list[Phase]:
     phases: list[Phase] = []
     subs = sim.spec.subtasks
     for grasp, move in zip(subs[0::2], subs[1::2], strict=True):
         obj = grasp.object
-        phases += pick_phases(sim, obj, _PERIOD.get(obj))
+        phases += pick_phases(sim, obj, _PERIOD.get(obj), _GRASP_DZ.get(obj, 0.0))
         drop = 0.10 if move.end_signal.startswith("placed") else 0.03
         carry = sim.point(move.goal)[2] + 0.20
         phases += place_phases(sim, move.goal, drop, carry)

@@ -136,6 +136,7 @@ def default_levels(milestones: Sequence[Sequence[str]]) -> list[LevelSpec]:
                     name=label,
                     terminate_subtask=sub,
                     terminate_at=at,
+                    terminal_w=(15, 40),  # short enough that the end still shows the level
                     deviations=(0, 2),
                     nested_prob=0.3,
                 )

@@ -163,9 +163,10 @@ def plan_trajectory(
 
     The trajectory follows the expert, branching at sorted random points q into
     recovered deviations (random actions, then interpolation to ``s^E_{q+h}``), some with
-    a nested deviation inside the recovery. Terminating levels end with an unrecovered
-    deviation starting inside ``level.terminate_subtask``; completing levels end with the
-    expert's final state.
+    a nested deviation inside the deviation or inside the recovery (branch points that
+    an earlier recovery already jumped past are dropped). Terminating levels end with an
+    unrecovered deviation starting inside ``level.terminate_subtask``; completing levels
+    end with the expert's final state.
 
     Args:
         expert_len: number of expert states T.

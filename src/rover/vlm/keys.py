@@ -18,7 +18,7 @@ _KNOWN: set[str] = set()
 _LOCK = threading.Lock()
 # OpenAI-style (sk-...), Google API keys (AIza...), bearer tokens in echoed headers
 _PATTERNS = re.compile(
-    r"(sk-[A-Za-z0-9_\-]{8,}|AIza[0-9A-Za-z_\-]{20,}|(?i:bearer)\s+[A-Za-z0-9._\-]{8,})"
+    r"(\bsk-[A-Za-z0-9_\-]{8,}|\bAIza[0-9A-Za-z_\-]{20,}|\b(?i:bearer)\s+[A-Za-z0-9._\-]{8,})"
 )
 # loggers of the HTTP stacks the SDKs use; filters are not inherited, so name them all
 _SDK_LOGGERS = (
@@ -29,6 +29,8 @@ _SDK_LOGGERS = (
     "httpcore",
     "httpcore.http11",
     "httpcore.connection",
+    "httpcore2.http11",
+    "httpcore2.connection",
     "google_genai",
     "google_genai._api_client",
     "google_genai.models",

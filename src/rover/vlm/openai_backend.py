@@ -9,6 +9,7 @@ The SDK's own retries are off (`max_retries=0`): our shared loop retries instead
 from __future__ import annotations
 
 import base64
+import os
 from typing import Any
 
 from rover.errors import BackendError
@@ -76,7 +77,8 @@ class OpenAIBackend(BaseBackend):
                 "the openai backend needs the 'openai' package: pip install 'openai>=1.40'"
             ) from exc
         install_log_scrubbing()
-        self.base_url = base_url or self.config.base_url
+        # OPENAI_BASE_URL is the SDK's own override; honour it here too so the key rule matches
+        self.base_url = base_url or self.config.base_url or os.environ.get("OPENAI_BASE_URL")
         env = self.config.api_key_env or DEFAULT_KEY_ENV
         key, _ = read_key(env)
         if key is None:

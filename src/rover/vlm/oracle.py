@@ -148,6 +148,7 @@ class BoundOracle(OracleBackend):
     def __init__(self, episode: Episode, config: BackendConfig | None = None) -> None:
         super().__init__(config)
         self.episode = episode
+        self._descriptions: dict[int, str] = {}  # deterministic per frame: compute once
 
     def bind(self, episode: Episode) -> BoundOracle:
         return self if episode is self.episode else BoundOracle(episode, self.config)
@@ -191,9 +192,12 @@ class BoundOracle(OracleBackend):
             raise BackendError(f"oracle: frame {exc} is not in episode {self.episode.id}") from exc
 
     def _desc(self, truth: GroundTruth, pos: int) -> str:
-        facts = truth.facts[pos] if truth.facts is not None else None
-        rng = _rng(self.config.seed, "desc", pos)
-        return describe(facts, self.config.flip_prob, rng)
+        hit = self._descriptions.get(pos)
+        if hit is None:
+            facts = truth.facts[pos] if truth.facts is not None else None
+            rng = _rng(self.config.seed, "desc", pos)
+            hit = self._descriptions[pos] = describe(facts, self.config.flip_prob, rng)
+        return hit
 
     def _noisy(self, p: float, *key: object) -> float:
         if self.config.jitter > 0:

@@ -1,0 +1,187 @@
+"""The rule judge: claims read from descriptions, checked against simulator facts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rover.episode import FrameFacts, ObjectFacts
+from rover.eval.claims import extract_claims, names_match
+from rover.eval.rule_judge import judge_description
+
+OBJECTS = ["can", "milk carton", "cereal box"]
+
+
+def random_facts(rng: np.random.Generator) -> FrameFacts:
+    obj = OBJECTS[int(rng.integers(len(OBJECTS)))]
+    holding = obj if rng.random() < 0.4 else None
+    state = "held" if holding else rng.choice(["table", "bin"])
+    return FrameFacts(
+        gripper="closed" if holding or rng.random() < 0.2 else "open",
+        contacts=[obj] if holding or rng.random() < 0.2 else [],
+        holding=holding,
+        objects={
+            obj: ObjectFacts(
+                lifted=state == "held",
+                on="table" if state == "table" else None,
+                inside=f"bin {int(rng.integers(1, 3))}" if state == "bin" else None,
+            )
+        },
+        articulations={"door": float(rng.choice([0.0, 0.25, 0.5, 1.0]))},
+        pressed=["button"] if rng.random() < 0.5 else [],
+    )
+
+
+def claims_for(f: FrameFacts, rng: np.random.Generator) -> list[tuple[str, str]]:
+    """(true sentence, false sentence) per claim, in several paraphrases."""
+    pick = lambda *opts: opts[int(rng.integers(len(opts)))]  # noqa: E731
+    obj, o = next(iter(f.objects.items()))
+    other = "closed" if f.gripper == "open" else "open"
+    out = [
+        (
+            pick(
+                f"The gripper is {f.gripper}.",
+                f"The robot's gripper is {f.gripper}.",
+                f"An {f.gripper} gripper is visible.",
+            ),
+            pick(f"The gripper is {other}.", f"The gripper is still {other}."),
+        )
+    ]
+    if f.holding:
+        out.append(
+            (
+                pick(
+                    f"The robot is holding the {obj}.",
+                    f"The robot is grasping the {obj}.",
+                    f"The {obj} is in the gripper.",
+                ),
+                pick("The robot is not holding anything.", "The gripper is empty."),
+            )
+        )
+    else:
+        out.append(
+            (
+                pick(
+                    "The robot is not holding anything.",
+                    "The gripper is empty.",
+                    "The robot is holding nothing.",
+                ),
+                f"The robot is holding the {obj}.",
+            )
+        )
+    touch = f"The gripper is touching the {obj}."
+    no_touch = pick(
+        f"The gripper is not touching the {obj}.", f"The gripper is not in contact with the {obj}."
+    )
+    out.append((touch, no_touch) if f.contacts else (no_touch, touch))
+    if o.lifted:
+        out.append(
+            (
+                pick(f"The {obj} is lifted.", f"The {obj} is in the air."),
+                f"The {obj} is not lifted.",
+            )
+        )
+    elif o.inside:
+        wrong = "bin 1" if o.inside == "bin 2" else "bin 2"
+        out.append(
+            (
+                pick(f"The {obj} is in {o.inside}.", f"The {obj} is inside {o.inside}."),
+                f"The {obj} is in {wrong}.",
+            )
+        )
+    else:
+        out.append((f"The {obj} is on the table.", f"The {obj} is not on the table."))
+    door = f.articulations["door"]
+    wrong_door = 1.0 - door if abs(1.0 - 2 * door) > 0.4 else door + 0.5
+    out.append(
+        (f"The door is {round(100 * door)}% open.", f"The door is {round(100 * wrong_door)}% open.")
+    )
+    pressed = bool(f.pressed)
+    p_true = "The button is pressed." if pressed else "The button is not pressed."
+    p_false = "The button is not pressed." if pressed else "The button is pressed."
+    out.append((p_true, p_false))
+    return out
+
+
+def test_injected_error_rate_is_measured_exactly() -> None:
+    rng = np.random.default_rng(7)
+    n_frames, flip_p = 500, 0.2
+    injected = measured_false = measured_true = total_claims = frames_with_error = 0
+    judged_error_frames = 0
+    for _ in range(n_frames):
+        facts = random_facts(rng)
+        sentences, flips = [], 0
+        for true_s, false_s in claims_for(facts, rng):
+            flip = rng.random() < flip_p
+            flips += flip
+            sentences.append(false_s if flip else true_s)
+        total_claims += len(sentences)
+        injected += flips
+        frames_with_error += flips > 0
+        j = judge_description(" ".join(sentences), facts)
+        measured_false += len(j.false_claims)
+        measured_true += len(j.true_claims)
+        judged_error_frames += j.verdict == "false"
+        assert len(j.false_claims) == flips, (sentences, j)
+    # exact counting: every injected error found, every other claim confirmed
+    assert measured_false == injected
+    assert measured_true == total_claims - injected
+    assert judged_error_frames == frames_with_error
+    # and the claim-level rate is the injected 20% within binomial noise
+    assert abs(measured_false / total_claims - flip_p) < 0.03
+    # frame error rate = P(at least one of ~6 claims flipped) = 1 - 0.8^6 ~ 0.74
+    assert abs(judged_error_frames / n_frames - (1 - 0.8**6)) < 0.06
+
+
+def test_oracle_vocabulary_with_its_own_noise() -> None:
+    oracle = pytest.importorskip("rover.vlm.oracle")
+    rng = np.random.default_rng(3)
+    flipped_total = false_total = 0
+    for i in range(200):
+        facts = random_facts(rng)
+        clean = oracle.describe(facts, 0.0)
+        noisy = oracle.describe(facts, 0.3, np.random.default_rng(i))
+        j_clean = judge_description(clean, facts)
+        assert j_clean.verdict == "true" and not j_clean.false_claims, (clean, j_clean)
+        # sentences that differ from the clean description are the flipped claims
+        a = [s for s in clean.split(". ")]
+        b = [s for s in noisy.split(". ")]
+        flipped = sum(x != y for x, y in zip(a, b, strict=False)) if len(a) == len(b) else None
+        j = judge_description(noisy, facts)
+        if flipped is not None:
+            assert len(j.false_claims) == flipped, (noisy, j)
+            flipped_total += flipped
+            false_total += len(j.false_claims)
+    assert flipped_total > 20 and false_total == flipped_total
+
+
+@pytest.mark.parametrize(
+    ("text", "verdict"),
+    [
+        ("The gripper is open.", "true"),
+        ("The gripper is closed.", "false"),
+        ("The arm moves toward the can.", "inconclusive"),
+        ("", "inconclusive"),
+        ("The robot is holding the can. The gripper is open.", "false"),
+        ("The can sits on the table and the gripper is open.", "true"),
+        ("The door is 45% open.", "true"),
+        ("The door is fully open.", "false"),
+        ("The door is partially open.", "true"),
+        ("The button has not been pressed.", "true"),
+        ("The robot pressed the button.", "false"),
+        ("The gripper isn't holding anything and is not touching the can.", "true"),
+    ],
+)
+def test_paraphrases(text: str, verdict: str) -> None:
+    facts = FrameFacts(
+        gripper="open", objects={"can": ObjectFacts(on="table")}, articulations={"door": 0.4}
+    )
+    assert judge_description(text, facts).verdict == verdict
+
+
+def test_claim_extraction_and_names() -> None:
+    kinds = [c.kind for c in extract_claims("The gripper is closed. The can is in bin 2.")]
+    assert kinds == ["gripper", "inside"]
+    assert names_match("soda can", "can") and names_match("bin 2", "bin_2")
+    assert not names_match("bin 1", "bin 2")
+    assert judge_description("The gripper is open.", None).verdict == "inconclusive"
