@@ -111,3 +111,20 @@ def test_sequence_example_records(tmp_path):
     ep = load_episode(f"rlds:{tmp_path}", size=None)
     assert ep.task == "wipe the table"
     assert np.array_equal(ep.frames(), frames)
+
+
+def test_mixed_frame_sizes_and_depth_camera_default(tmp_path):
+    from .conftest import encode_image
+
+    small, big = frames_for(1, 32)[0], frames_for(1, 48)[0]
+    feats = {
+        "steps/observation/depth_image": [encode_image(small)] * 2,
+        "steps/observation/top_rgb": [encode_image(small), encode_image(big)],
+        "steps/language_instruction": [b"push the button"] * 2,
+    }
+    write_tfrecord(tmp_path / "mix-train.tfrecord-00000-of-00001", [encode_example(feats)])
+    reader = open_source(f"rlds:{tmp_path}")
+    with pytest.raises(InputError, match=r"'steps/observation/top_rgb'.*frame 1 is 48x48"):
+        reader.read(reader.episode_ids()[0])  # the colour camera is the default, not depth
+    depth = load_episode(f"rlds:{tmp_path}?camera=depth_image")
+    assert depth.view == "depth_image" and depth.task == "push the button"

@@ -86,7 +86,8 @@ class HDF5Source(SourceReader):
                 )
             total = int(dset.shape[0])
             positions = sample_positions(total, frames)
-            pixels = np.ascontiguousarray(dset[positions][..., :3])
+            chunk = dset[:] if len(positions) == total else dset[positions]
+            pixels = np.ascontiguousarray(chunk[..., :3])
             ep_meta = _json_attr(demo.attrs.get("ep_meta"))
         if self.flip:
             pixels = np.ascontiguousarray(pixels[:, ::-1])

@@ -37,7 +37,7 @@ from PIL import Image, UnidentifiedImageError
 
 from rover.episode import Episode
 from rover.errors import InputError
-from rover.io.frames import to_rgb_array
+from rover.io.frames import stack_frames, to_rgb_array
 from rover.io.plain import sample_positions
 from rover.io.seek import VideoIndex, decode_frames, index_video
 from rover.io.source import SourceReader
@@ -94,6 +94,8 @@ class LeRobotSource(SourceReader):
         if self.camera_dtype == "video" and not self.info.get("video_path"):
             raise InputError(f"{self.root / INFO}: missing field 'video_path'")
         self.chunks_size = int(self.info.get("chunks_size", 1000))
+        if self.only_episode is not None and self.only_episode.isdigit():
+            self.only_episode = f"episode_{int(self.only_episode):06d}"  # "?episode=3" works
         self._episodes = self._load_episode_table()
         self._tasks: dict[int, str] | None = None
         self._video_index: dict[Path, VideoIndex] = {}  # v3 files hold many episodes
@@ -152,7 +154,10 @@ class LeRobotSource(SourceReader):
             images = table[self.camera]
             length = len(images)
             positions = sample_positions(length, frames)
-            pixels = np.stack([self._decode_image(images[p], p) for p in positions])
+            pixels = stack_frames(
+                [self._decode_image(images[p], p) for p in positions],
+                f"{self.root}: column {self.camera!r} of episode {idx}",
+            )
         return Episode(
             id=episode_id,
             task=self.task if self.task is not None else self._task_text(idx, row),

@@ -26,7 +26,7 @@ from PIL import Image, UnidentifiedImageError
 
 from rover.episode import Episode
 from rover.errors import InputError
-from rover.io.frames import to_rgb_array
+from rover.io.frames import stack_frames, to_rgb_array
 from rover.io.plain import sample_positions
 from rover.io.source import SourceReader
 from rover.io.tfrecord import Feature, RecordSpan, decode_example, read_record, scan_records
@@ -34,6 +34,7 @@ from rover.io.tfrecord import Feature, RecordSpan, decode_example, read_record, 
 DEFAULT_FPS = 10.0  # RLDS does not store a frame rate; OpenX control rates are 3-30 Hz
 _SHARD = re.compile(r"-(?P<split>[A-Za-z0-9_]+)\.tfrecord-(?P<shard>\d+)-of-\d+$")
 _MAGIC = (b"\xff\xd8\xff", b"\x89PNG")
+_NOT_COLOR = ("depth", "seg", "mask", "flow")  # image fields a VLM should not get by default
 _LANGUAGE_HINTS = (
     "language_instruction",
     "natural_language_instruction",
@@ -170,7 +171,10 @@ class RLDSSource(SourceReader):
             )
         images: list[bytes] = feature.value  # type: ignore[assignment]
         positions = sample_positions(len(images), frames)
-        pixels = np.stack([_decode_image(images[p], where, camera, p) for p in positions])
+        pixels = stack_frames(
+            [_decode_image(images[p], where, camera, p) for p in positions],
+            f"{where}: feature {camera!r}",
+        )
         return Episode(
             id=episode_id,
             task=self.task if self.task is not None else self._instruction(steps, features),
@@ -208,8 +212,9 @@ class RLDSSource(SourceReader):
 
     def _pick_camera(self, cameras: list[str], where: str) -> str:
         if self.view is None:
-            preferred = [c for c in cameras if _short(c) == "image"]
-            return preferred[0] if preferred else cameras[0]
+            exact = [c for c in cameras if _short(c) == "image"]
+            color = [c for c in cameras if not any(w in _short(c) for w in _NOT_COLOR)]
+            return (exact or color or cameras)[0]
         for c in cameras:
             if self.view in (c, _short(c), c.removeprefix("steps/")):
                 return c

@@ -304,20 +304,42 @@ def _bars(rows, metric, label, variants, colors, key, xlabel, attr="variant") ->
 
 
 def _time_diff_hist(rows, variants, colors) -> Figure:
-    fig = _new_figure(6.4, 3.2)
-    ax = fig.subplots()
+    """Per method: a histogram as a row of dots (one per question) over a box of quartiles.
+
+    Overlaid histograms of eight methods hide each other; one row per method keeps every
+    distribution visible and still reads like the paper's histogram (App. A, Fig. 3).
+    """
     diffs_by = {v: [d for r in rows if r.variant == v for d in r.qa_time_diffs] for v in variants}
-    everything = [d for ds in diffs_by.values() for d in ds]
-    lo, hi = min(everything + [-1]), max(everything + [1])
-    bins = np.arange(lo - 0.5, hi + 1.5, max(1, math.ceil((hi - lo + 1) / 30)))
-    for v, ds in diffs_by.items():
-        if ds:
-            ax.hist(ds, bins=bins, histtype="step", linewidth=1.6, color=colors[v], label=v)
+    shown = [v for v in variants if diffs_by[v]]
+    fig = _new_figure(6.4, 0.9 + 0.42 * len(shown))
+    ax = fig.subplots()
+    rng = np.random.default_rng(0)  # jitter only spreads overlapping dots; fixed for stability
+    for i, v in enumerate(shown):
+        ds = np.asarray(diffs_by[v], dtype=float)
+        y = len(shown) - 1 - i
+        q1, med, q3 = np.percentile(ds, [25, 50, 75])
+        ax.barh(
+            y,
+            max(q3 - q1, 0.2),
+            left=q1 if q3 > q1 else q1 - 0.1,
+            height=0.6,
+            color=colors[v],
+            alpha=0.25,
+            edgecolor=colors[v],
+        )
+        ax.vlines(med, y - 0.3, y + 0.3, color="black", linewidth=1.2)
+        ax.scatter(
+            ds + rng.uniform(-0.15, 0.15, len(ds)),
+            y + rng.uniform(-0.22, 0.22, len(ds)),
+            s=10,
+            color=colors[v],
+            alpha=0.7,
+            zorder=3,
+        )
+    ax.set_yticks(range(len(shown)), list(reversed(shown)))
     ax.axvline(0, color="black", linewidth=0.8, linestyle="--")
-    ax.set_xlabel("Stated frame - actual frame")
-    ax.set_ylabel("Questions")
-    ax.grid(alpha=0.3)
-    _legend(fig, ax)
+    ax.set_xlabel("Stated frame - actual frame (negative: stated too early)")
+    ax.grid(axis="x", alpha=0.3)
     return fig
 
 

@@ -110,8 +110,11 @@ def grasp_yaw(sim: SimEnv, obj: str, period: float, offset: float = 0.0) -> floa
     At yaw 0 the fingers close along world y; `offset` turns them to pinch across the
     object's x extent instead (a cereal box is only thin along x).
     """
-    spec = sim.spec.object_spec(obj)
-    mat = sim.data.xmat[sim._body_id(spec.body)].reshape(3, 3)
+    geoms = [g for g, o in sim._geom_owner.items() if o == obj and sim.model.geom_contype[g]]
+    if geoms:  # the collision box's frame (a mesh object's body frame may be turned)
+        mat = sim.data.geom_xmat[geoms[0]].reshape(3, 3)
+    else:
+        mat = sim.data.xmat[sim._body_id(sim.spec.object_spec(obj).body)].reshape(3, 3)
     return _wrap(_yaw_of(mat) + offset, period)
 
 
