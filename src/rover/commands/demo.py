@@ -110,11 +110,13 @@ def _bundled() -> Path:
 
 
 def _generate(target: Path, console: Console) -> Path:
-    try:
-        import mujoco  # noqa: F401
-        import robosuite  # noqa: F401
-    except ImportError as exc:
-        raise MissingExtraError("mujoco", "sim", "rover demo --generate") from exc
+    import importlib.util
+
+    import rover.sim  # noqa: F401  (sets MUJOCO_GL before anything imports mujoco)
+
+    for package in ("mujoco", "robosuite"):
+        if importlib.util.find_spec(package) is None:
+            raise MissingExtraError(package, "sim", "rover demo --generate")
     from rover.sim.generate import GenerateConfig, generate
 
     cfg = GenerateConfig(tasks=GENERATE_TASKS, per_level=1, size=128, demos=1, seed=0)

@@ -5,10 +5,12 @@ camera view, backend, frame count, window, dataset. Frame-level strata (App. G):
 state type at that frame and how many frames the method had in its context when it
 predicted that frame.
 
-Frames in context are read from the trace's call records: a frame's prediction comes from
-the *first* call whose images include that frame (ROVER shows a frame first as "current
-frame", later calls only reuse it as context; GVL/TemporalConcat's call for timestep t is
-the first to contain frame t; a single-call method shows every frame in its one call).
+Frames in context are read from the trace's call records, independent of the order calls
+finished in (concurrent calls finish in any order): a frame's prediction comes from a call
+whose *latest* frame is that frame (ROVER's "current frame" comes after its window;
+GVL/TemporalConcat's call for timestep t shows frames up to t, in whatever order), the
+largest such call if several (a ROVER step rather than its parent turn). Frames that are
+never the latest of any call (a single-call method) take the smallest call showing them.
 The count is the number of distinct frames that call sent.
 """
 
@@ -23,12 +25,18 @@ NONEXPERT_EDGES = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0)
 
 def context_frames(trace: Trace) -> dict[int, int]:
     """Original frame index -> number of frames in context when it was predicted."""
-    out: dict[int, int] = {}
-    for call in sorted(trace.calls, key=lambda c: c.id):
-        n = len(set(call.frame_indices))
-        for idx in call.frame_indices:
-            out.setdefault(idx, n)
-    return out
+    as_latest: dict[int, int] = {}
+    smallest: dict[int, int] = {}
+    for call in trace.calls:
+        frames = set(call.frame_indices)
+        if not frames:
+            continue
+        n = len(frames)
+        last = max(frames)
+        as_latest[last] = max(as_latest.get(last, 0), n)
+        for idx in frames:
+            smallest[idx] = min(smallest.get(idx, n), n)
+    return {idx: as_latest.get(idx, n) for idx, n in smallest.items()}
 
 
 def context_bin(n: int | None) -> str | None:

@@ -147,7 +147,8 @@ def pick_phases(
         Phase(above, OPEN, tol=0.015, steps=80, yaw=yaw),
         Phase(at, OPEN, tol=0.006, steps=40, gain=1.5),
         Phase(freeze, CLOSE, tol=None, steps=10),
-        Phase(lambda: here() + np.array([0, 0, start_z + 0.15 - here()[2]]), CLOSE, 0.02, 40),
+        Phase(lambda: here() + np.array([0, 0, start_z + 0.15 - here()[2]]), CLOSE, 0.02, 60,
+              gain=0.6),
     ]
 
 
@@ -169,7 +170,7 @@ def place_phases(sim: SimEnv, goal: str, drop_dz: float, carry_z: float) -> list
         return rest[0]
 
     return [
-        Phase(over, CLOSE, tol=0.02, steps=100),
+        Phase(over, CLOSE, tol=0.02, steps=120, gain=0.6),
         Phase(down, CLOSE, tol=0.01, steps=50),
         Phase(freeze, OPEN, tol=None, steps=8),
         Phase(lambda: freeze() + np.array([0, 0, 0.08]), OPEN, tol=0.02, steps=20),
@@ -182,7 +183,7 @@ _PERIOD = {"cube": np.pi / 2, "red cube": np.pi / 2, "can": None, "milk": np.pi 
 
 
 # tall objects: grasp this far above their centre so the palm clears their top (m)
-_GRASP_DZ = {"milk": 0.045, "cereal": 0.04}
+_GRASP_DZ = {"milk": 0.045, "cereal": 0.035}
 _YAW_OFFSET = {"cereal": np.pi / 2}
 
 
