@@ -35,8 +35,11 @@ def main() -> None:
             steps += len(demo.actions)
         took = (time.perf_counter() - start) / args.seeds
         table.add_row(
-            name, f"{ok}/{args.seeds}", f"{ok / args.seeds:.0%}",
-            f"{steps / args.seeds:.0f}", f"{took:.2f}",
+            name,
+            f"{ok}/{args.seeds}",
+            f"{ok / args.seeds:.0%}",
+            f"{steps / args.seeds:.0f}",
+            f"{took:.2f}",
         )
         Console().print(f"{name}: {ok}/{args.seeds}")
     Console().print(table)

@@ -80,9 +80,11 @@ def test_context_frames_from_first_call_showing_each_frame() -> None:
     tr = tr.model_copy(update={"calls": calls})
     assert context_frames(tr) == {0: 1, 1: 2, 2: 3, 3: 3}
     # GVL-like: shuffled frames per timestep, calls recorded in completion order
-    calls = [CallRecord(id=0, kind="gvl.batch", frame_indices=[2, 0, 1]),
-             CallRecord(id=1, kind="gvl.batch", frame_indices=[1, 0]),
-             CallRecord(id=2, kind="gvl.batch", frame_indices=[3, 1, 0, 2])]
+    calls = [
+        CallRecord(id=0, kind="gvl.batch", frame_indices=[2, 0, 1]),
+        CallRecord(id=1, kind="gvl.batch", frame_indices=[1, 0]),
+        CallRecord(id=2, kind="gvl.batch", frame_indices=[3, 1, 0, 2]),
+    ]
     assert context_frames(tr.model_copy(update={"calls": calls})) == {0: 2, 1: 2, 2: 3, 3: 4}
     # one call showing everything (GVL single call): every frame had all 4 in context
     calls = [CallRecord(id=0, kind="gvl.batch", frame_indices=[3, 0, 2, 1])]

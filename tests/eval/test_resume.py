@@ -25,9 +25,25 @@ METHODS = "temporal-concat,local-concat"
 
 
 def _cmd(ds: Path, out: Path, url: str, resume: bool) -> list[str]:
-    cmd = [sys.executable, "-m", "rover.cli", "eval", "--dataset", str(ds), "--methods", METHODS,
-           "--backend", f"openai:loop@{url}", "--no-cache", "--concurrency", "2",
-           "--calls-in-flight", "2", "--out", str(out)]
+    cmd = [
+        sys.executable,
+        "-m",
+        "rover.cli",
+        "eval",
+        "--dataset",
+        str(ds),
+        "--methods",
+        METHODS,
+        "--backend",
+        f"openai:loop@{url}",
+        "--no-cache",
+        "--concurrency",
+        "2",
+        "--calls-in-flight",
+        "2",
+        "--out",
+        str(out),
+    ]
     return cmd + (["--resume"] if resume else [])
 
 
@@ -39,8 +55,14 @@ def _env() -> dict[str, str]:
 
 
 def _traces(out: Path) -> dict[str, str]:
-    return {str(p.relative_to(out)): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in (out / "traces").rglob("*.json")} if (out / "traces").exists() else {}
+    return (
+        {
+            str(p.relative_to(out)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in (out / "traces").rglob("*.json")
+        }
+        if (out / "traces").exists()
+        else {}
+    )
 
 
 def _comparable(metrics: dict) -> dict:
@@ -50,7 +72,8 @@ def _comparable(metrics: dict) -> dict:
 
 
 def _calls(out: Path) -> int:
-    return sum(json.loads(p.read_text())["totals"]["calls"] for p in (out / "traces").rglob("*.json"))
+    paths = (out / "traces").rglob("*.json")
+    return sum(json.loads(p.read_text())["totals"]["calls"] for p in paths)
 
 
 @pytest.mark.slow
@@ -62,20 +85,31 @@ def test_sigkill_and_resume_five_times(tmp_path: Path, make_dataset, loopback_vl
 
     # reference: one uninterrupted run
     ref_out = tmp_path / "ref"
-    subprocess.run(_cmd(ds, ref_out, server.url, False), env=_env(), check=True,
-                   capture_output=True, timeout=300)
+    subprocess.run(
+        _cmd(ds, ref_out, server.url, False),
+        env=_env(),
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
     assert server.requests == _calls(ref_out)  # every request ends up in a trace
     server.requests = 0
 
     out = tmp_path / "run"
     finished: dict[str, str] = {}
     kills = 0
+    progress: list[int] = []
     for attempt in range(5):
-        proc = subprocess.Popen(_cmd(ds, out, server.url, attempt > 0), env=_env(),
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        proc = subprocess.Popen(
+            _cmd(ds, out, server.url, attempt > 0),
+            env=_env(),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         # kill after a random amount of new progress, so kills land mid-run
         start_lines = len(read_units_log(out)) if out.exists() else 0
-        target = start_lines + int(rng.integers(1, 5))
+        # a full run logs 6 lines per unit (start/done of trace, judge, qa): 60 in all
+        target = start_lines + int(rng.integers(1, max(2, (60 - start_lines) // 2 + 1)))
         deadline = time.time() + 120
         while proc.poll() is None and time.time() < deadline:
             if len(read_units_log(out)) >= target:
@@ -90,11 +124,13 @@ def test_sigkill_and_resume_five_times(tmp_path: Path, make_dataset, loopback_vl
         # nothing finished before was ever rewritten
         assert all(now.get(k) == v for k, v in finished.items())
         finished = now
+        progress.append(len(finished))
     assert kills >= 3, "the run finished before it could be interrupted"
-    assert len(finished) < 10  # work was really left for the final resume
+    assert 0 < len(finished) < 10, progress  # kills landed mid-run, after some finished work
 
-    done = subprocess.run(_cmd(ds, out, server.url, True), env=_env(), capture_output=True,
-                          text=True, timeout=300)
+    done = subprocess.run(
+        _cmd(ds, out, server.url, True), env=_env(), capture_output=True, text=True, timeout=300
+    )
     assert done.returncode == 0, done.stderr
     final = _traces(out)
     assert len(final) == 10 and all(final[k] == v for k, v in finished.items())
@@ -114,8 +150,9 @@ def test_sigkill_and_resume_five_times(tmp_path: Path, make_dataset, loopback_vl
         key = line["unit"]
         if line["event"] == "start":
             starts[key] = starts.get(key, 0) + 1
-            assert not any(x["unit"] == key and x["stage"] == "trace" and x["event"] == "done"
-                           for x in log[:i]), f"{key} restarted after it finished"
+            assert not any(
+                x["unit"] == key and x["stage"] == "trace" and x["event"] == "done" for x in log[:i]
+            ), f"{key} restarted after it finished"
     assert sum(1 for x in log if x["stage"] == "trace" and x["event"] == "done") == 10
     # backend requests: every finished trace's calls, plus at most one partial attempt per
     # interruption of a unit (an interrupted attempt makes at most a full attempt's calls)

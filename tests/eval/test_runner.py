@@ -26,8 +26,18 @@ def _metrics(out: Path) -> dict:
 def test_oracle_run_end_to_end(tmp_path: Path, make_dataset) -> None:
     ds = make_dataset(tmp_path / "ds", n=3, frames=12)
     out = tmp_path / "run"
-    res = _eval("--dataset", str(ds), "--methods", "rover,gvl,temporal-concat,local-concat",
-                "--backend", "oracle", "--out", str(out), "--concurrency", "4")
+    res = _eval(
+        "--dataset",
+        str(ds),
+        "--methods",
+        "rover,gvl,temporal-concat,local-concat",
+        "--backend",
+        "oracle",
+        "--out",
+        str(out),
+        "--concurrency",
+        "4",
+    )
     assert res.exit_code == 0, res.output
     metrics = _metrics(out)
     assert metrics["counts"]["traces"] == 12
@@ -46,16 +56,29 @@ def test_oracle_run_end_to_end(tmp_path: Path, make_dataset) -> None:
     assert len(list((out / "judgements").rglob("*.json"))) == 12
     assert "rover eval: mean" in res.output and "run directory" in res.output  # main table
     # traces are the only JSON files with the Trace shape (the report relies on it)
-    trace_like = [p for p in out.rglob("*.json")
-                  if {"method", "frames"} <= set(json.loads(p.read_text()))]
+    trace_like = [
+        p for p in out.rglob("*.json") if {"method", "frames"} <= set(json.loads(p.read_text()))
+    ]
     assert all(p.parts[-3] == "traces" for p in trace_like)
 
 
 def test_sweeps_make_one_variant_per_combination(tmp_path: Path, make_dataset) -> None:
     ds = make_dataset(tmp_path / "ds", n=2, frames=12, wrist=True)
     out = tmp_path / "run"
-    res = _eval("--dataset", str(ds), "--methods", "rover,gvl", "--frames", "6,12",
-                "--window", "3,6", "--views", "left,wrist", "--out", str(out))
+    res = _eval(
+        "--dataset",
+        str(ds),
+        "--methods",
+        "rover,gvl",
+        "--frames",
+        "6,12",
+        "--window",
+        "3,6",
+        "--views",
+        "left,wrist",
+        "--out",
+        str(out),
+    )
     assert res.exit_code == 0, res.output
     m = _metrics(out)
     ids = {v["id"] for v in m["variants"]}
@@ -64,8 +87,9 @@ def test_sweeps_make_one_variant_per_combination(tmp_path: Path, make_dataset) -
     assert "rover__b=oracle__f=6__w=6__v=wrist" in ids
     assert "gvl__b=oracle__f=12__w=na__v=left" in ids
     assert len({v["label"] for v in m["variants"]}) == 12
-    trace = json.loads((out / "traces" / "ep0" / "rover__b=oracle__f=6__w=6__v=wrist.json")
-                       .read_text())
+    trace = json.loads(
+        (out / "traces" / "ep0" / "rover__b=oracle__f=6__w=6__v=wrist.json").read_text()
+    )
     assert trace["num_frames"] == 6 and trace["params"]["window"] == 6
     assert trace["view"] == "wrist"
     assert trace["frame_indices"] == [0, 2, 4, 7, 9, 11]  # Episode.subsample(6) of 12
@@ -91,8 +115,7 @@ def test_failing_episode_is_recorded_and_the_run_goes_on(tmp_path: Path, make_da
     assert "ep1" in (out / "summary.md").read_text()
     # the video repaired, a resume does only the failed unit and clears its error
     video.write_bytes(good)
-    res = _eval("--dataset", str(ds), "--methods", "temporal-concat", "--out", str(out),
-                "--resume")
+    res = _eval("--dataset", str(ds), "--methods", "temporal-concat", "--out", str(out), "--resume")
     assert res.exit_code == 0, res.output
     assert _metrics(out)["counts"]["failed"] == 0
     assert (out / "errors.jsonl").read_text() == ""
@@ -103,18 +126,38 @@ def test_llm_judge_and_answerer_over_http(tmp_path: Path, make_dataset, loopback
     ds = make_dataset(tmp_path / "ds", n=2, frames=8)
     out = tmp_path / "run"
     judge = f"openai:judge-model@{server.url}"
-    res = _eval("--dataset", str(ds), "--methods", "temporal-concat", "--backend", "oracle",
-                "--flip-prob", "0.3", "--judge", judge, "--answerer", judge, "--no-cache",
-                "--out", str(out))
+    res = _eval(
+        "--dataset",
+        str(ds),
+        "--methods",
+        "temporal-concat",
+        "--backend",
+        "oracle",
+        "--flip-prob",
+        "0.3",
+        "--judge",
+        judge,
+        "--answerer",
+        judge,
+        "--no-cache",
+        "--out",
+        str(out),
+    )
     assert res.exit_code == 0, res.output
     from rover.episode import FrameFacts
 
     described = 0
     for eid in ("ep0", "ep1"):
-        j = json.loads((out / "judgements" / eid / "temporal-concat__b=oracle__f=all__w=na__v="
-                        "default.json").read_text())
-        trace = json.loads((out / "traces" / eid / "temporal-concat__b=oracle__f=all__w=na__v="
-                            "default.json").read_text())
+        j = json.loads(
+            (
+                out / "judgements" / eid / "temporal-concat__b=oracle__f=all__w=na__v=default.json"
+            ).read_text()
+        )
+        trace = json.loads(
+            (
+                out / "traces" / eid / "temporal-concat__b=oracle__f=all__w=na__v=default.json"
+            ).read_text()
+        )
         n = sum(bool(f["description"]) for f in trace["frames"])
         assert j["judge"] == judge and j["calls"] == n
         described += n
@@ -154,8 +197,9 @@ def _main(monkeypatch, capsys, *args: str) -> tuple[int, str]:
         (["--dataset", "{ds}", "--out", "{ds}"], "not empty; add --resume"),
     ],
 )
-def test_bad_inputs_give_one_line_errors(tmp_path, make_dataset, monkeypatch, capsys, args,
-                                         message) -> None:
+def test_bad_inputs_give_one_line_errors(
+    tmp_path, make_dataset, monkeypatch, capsys, args, message
+) -> None:
     ds = make_dataset(tmp_path / "ds", n=1, frames=4)
     args = [a.format(tmp=tmp_path, ds=ds) for a in args]
     if "--out" not in args:
@@ -170,16 +214,35 @@ def test_resume_with_other_options_is_refused(tmp_path, make_dataset, monkeypatc
     ds = make_dataset(tmp_path / "ds", n=1, frames=4)
     out = tmp_path / "run"
     assert _eval("--dataset", str(ds), "--methods", "gvl", "--out", str(out)).exit_code == 0
-    code, err = _main(monkeypatch, capsys, "--dataset", str(ds), "--methods", "rover",
-                      "--out", str(out), "--resume")
+    code, err = _main(
+        monkeypatch,
+        capsys,
+        "--dataset",
+        str(ds),
+        "--methods",
+        "rover",
+        "--out",
+        str(out),
+        "--resume",
+    )
     assert code != 0 and "this run was made with methods=['gvl']" in err
 
 
 def test_command_line_secrets_are_scrubbed() -> None:
     from rover.eval.runconfig import scrub_argv
 
-    argv = ["rover", "eval", "--api-key", "abc123secret", "--token=xyz", "--api-key-env", "MYKEY",
-            "--backend", "openai:gpt-4o@https://user:pw@host/v1?key=s3cr3t", "sk-abcdefghijklmn"]
+    argv = [
+        "rover",
+        "eval",
+        "--api-key",
+        "abc123secret",
+        "--token=xyz",
+        "--api-key-env",
+        "MYKEY",
+        "--backend",
+        "openai:gpt-4o@https://user:pw@host/v1?key=s3cr3t",
+        "sk-abcdefghijklmn",
+    ]
     out = " ".join(scrub_argv(argv))
     for secret in ("abc123secret", "xyz", "pw@", "s3cr3t", "sk-abcdefghijklmn"):
         assert secret not in out

@@ -122,3 +122,31 @@ def test_missing_run_dir_is_an_input_error(tmp_path: Path) -> None:
     (tmp_path / "empty").mkdir()
     with pytest.raises(InputError, match="no traces"):
         build_report(tmp_path / "empty")
+
+
+def test_sweep_figures_from_a_real_eval_run(make_run, tmp_path: Path) -> None:
+    """Frame-count and window sweeps (App. H, M) through the evaluation runner itself."""
+    import asyncio
+
+    from rover.eval.runner import EvalOptions, run_eval
+    from rover.vlm.config import BackendConfig
+
+    dataset = make_run().parent.parent / "dataset"
+    opts = EvalOptions(
+        dataset=dataset,
+        methods=["rover", "gvl"],
+        backends=["oracle"],
+        frames=[5, 10],
+        windows=[3, 6],
+        out=tmp_path / "sweep",
+        backend_config=BackendConfig(no_cache=True, jitter=5.0),
+    )
+    asyncio.run(run_eval(opts))
+    index = build_report(tmp_path / "sweep")
+    figures = {p.name for p in (index.parent / "figures").iterdir()}
+    assert {"pearson_by_frame_count.svg", "window_ablation.svg"} <= figures
+    page = index.read_text()
+    # the summary lists every configuration; the main figures say which setting they show
+    for label in ("ROVER · 5 frames", "ROVER (window 6) · 10 frames", "GVL · 5 frames"):
+        assert label in page
+    assert "Shown at 10 frames per video" in page

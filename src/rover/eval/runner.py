@@ -32,8 +32,8 @@ from rover.eval.episodes import (
 )
 from rover.eval.judge import llm_judge_trace, rule_judge_trace
 from rover.eval.qa import llm_answer_trace, rule_answer_trace
-from rover.eval.rundir import RunDir, write_json_atomic
 from rover.eval.runconfig import run_config
+from rover.eval.rundir import RunDir, write_json_atomic
 from rover.eval.variants import Variant, expand_variants
 from rover.methods.trace import Trace
 from rover.vlm.config import BackendConfig
@@ -147,6 +147,7 @@ class Runner:
         refs: list[EpisodeRef],
         variants: list[Variant],
         on_update: OnUpdate | None = None,
+        vlms: dict[str, Any] | None = None,
     ) -> None:
         self.opts = opts
         self.rundir = RunDir(opts.out)
@@ -160,15 +161,18 @@ class Runner:
             self.stages.append("judge")
         if opts.answerer.lower() not in OFF:
             self.stages.append("qa")
-        self.vlms = {b: _load_backend(b, opts.backend_config) for b in opts.backends}
+        given = self._given = vlms or {}
+        self.vlms = {
+            b: given.get(b) or _load_backend(b, opts.backend_config) for b in opts.backends
+        }
         self.judge_vlm = self._aux(opts.judge)
         self.answer_vlm = self._aux(opts.answerer)
 
     def _aux(self, spec: str) -> Any:
         if spec.lower() in OFF or spec.lower() == "rule":
             return None
-        if spec in self.vlms:
-            return self.vlms[spec]
+        if spec in self.vlms or spec in self._given:
+            return self.vlms.get(spec) or self._given[spec]
         config = self.opts.backend_config.model_copy(update={"flip_prob": 0.0, "jitter": 0.0})
         return _load_backend(spec, config)
 
@@ -296,8 +300,13 @@ def build_variants(opts: EvalOptions) -> list[Variant]:
     return expand_variants(opts.methods, opts.backends, opts.frames, opts.windows, opts.views)
 
 
-def prepare_run(opts: EvalOptions, on_update: OnUpdate | None = None) -> Runner:
+def prepare_run(
+    opts: EvalOptions, on_update: OnUpdate | None = None, vlms: dict[str, Any] | None = None
+) -> Runner:
     """Check every input, load the backends and set up the run directory (no VLM calls).
+
+    `vlms` maps backend specs to ready VLM objects, for library users with their own VLM
+    class (anything with `complete` and `bind`); other specs go through `load_vlm`.
 
     Raises:
         InputError: unknown method, bad sweep value, missing dataset, non-empty --out...
@@ -307,7 +316,8 @@ def prepare_run(opts: EvalOptions, on_update: OnUpdate | None = None) -> Runner:
     refs = episode_refs(opts)
     _warm_up()
     config = run_config(opts, variants, refs)
-    runner = Runner(opts, config, refs, variants, on_update)  # loads backends: fail before writing
+    # backends load before anything is written, so a bad spec leaves no half-made run dir
+    runner = Runner(opts, config, refs, variants, on_update, vlms)
     RunDir(opts.out).prepare(config, opts.resume)
     return runner
 

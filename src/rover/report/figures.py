@@ -31,6 +31,12 @@ PALETTE = [
     "#7f7f7f",
     "#bcbd22",
     "#17becf",
+    "#393b79",
+    "#e7969c",
+    "#637939",
+    "#ffbb78",
+    "#c5b0d5",
+    "#8c6d31",
 ]
 ORACLE_NOTE = "ORACLE OUTPUT: answers come from simulator ground truth, not a VLM"
 
@@ -122,10 +128,20 @@ _STYLE = {
 
 def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[FigureFile]:
     out.mkdir(parents=True, exist_ok=True)
-    variants = variants_in_order(rows)
-    series = variants_in_order(rows, "series")
     colors = variant_colors(rows)
     written: list[FigureFile] = []
+    # The paper's main figures compare methods at one setting; sweeps get their own figures.
+    frames0, view0 = _primary_setting(rows)
+    at_view = [r for r in rows if r.view == view0]
+    at_frames = [r for r in rows if r.num_frames == frames0]
+    main = [r for r in at_frames if r.view == view0]
+    series = variants_in_order(main, "series")
+    note = ""
+    if len(main) < len(rows):
+        note = (
+            f" Shown at {frames0} frames per video, view {view0 or 'default'}; other "
+            "settings are in the sweep figures and the summary table."
+        )
 
     def save(fig: Figure, name: str, title: str, caption: str) -> None:
         if oracle:  # a suptitle gets its own room in the constrained layout
@@ -137,41 +153,42 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
         )
 
     for metric, (label, title, caption) in METRICS.items():
-        if not any(getattr(r, metric) is not None for r in rows):
+        if not any(getattr(r, metric) is not None for r in main):
             continue
-        fig = _two_panel_bars(rows, metric, label, variants, colors)
-        save(fig, f"{metric}_by_group_level", title, caption)
+        fig = _two_panel_bars(main, metric, label, series, colors)
+        save(fig, f"{metric}_by_group_level", title, caption + note)
 
-    if any(r.qa_time_diffs for r in rows):
+    if any(r.qa_time_diffs for r in main):
         save(
-            _time_diff_hist(rows, variants, colors),
+            _time_diff_hist(main, series, colors),
             "qa_temporal_distance",
             "Video QA: temporal distance",
             "Frames between when a method's descriptions say an event happened and when it "
-            "did (negative: stated too early). Only questions answered yes correctly.",
+            "did (negative: stated too early). Only questions answered yes correctly." + note,
         )
-    if any(r.non_expert_share is not None for r in rows):
+    if any(r.non_expert_share is not None for r in main):
         save(
             _line_by(
-                rows,
-                variants,
+                main,
+                series,
                 colors,
                 "frame_corr",
                 _non_expert_bin,
                 "Share of non-expert frames",
                 "Correlation with frame number",
+                attr="series",
             ),
             "frame_corr_by_non_expert",
             "Progress: correlation with frame number",
             "Mean and standard error of the correlation between frame number and predicted "
             "progress, by the share of non-expert states in the video (App. A.1). Accurate "
-            "reasoning should track frame number less as the share grows.",
+            "reasoning should track frame number less as the share grows." + note,
         )
-    if len({r.num_frames for r in rows}) > 1 and any(r.pearson is not None for r in rows):
+    if len({r.num_frames for r in at_view}) > 1 and any(r.pearson is not None for r in at_view):
         save(
             _line_by(
-                rows,
-                series,
+                at_view,
+                variants_in_order(at_view, "series"),
                 colors,
                 "pearson",
                 lambda r: r.num_frames,
@@ -184,12 +201,12 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
             "Mean and standard error of the correlation with ground truth as the same videos "
             "are sampled with more frames (App. H).",
         )
-    if len({r.view for r in rows}) > 1 and any(r.pearson is not None for r in rows):
+    if len({r.view for r in at_frames}) > 1 and any(r.pearson is not None for r in at_frames):
         fig = _bars(
-            rows,
+            at_frames,
             "pearson",
             "Pearson r with ground truth",
-            series,
+            variants_in_order(at_frames, "series"),
             colors,
             lambda r: r.view or "default",
             "Camera view",
@@ -201,8 +218,8 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
             "Robustness to camera view",
             "Mean and standard error of the correlation with ground truth by camera view.",
         )
-    window_rows = [r for r in rows if r.method == "rover" and r.window]
-    if len({r.window for r in window_rows}) > 1 and any(r.pearson is not None for r in rows):
+    window_rows = [r for r in main if r.method == "rover" and r.window]
+    if len({r.window for r in window_rows}) > 1 and any(r.pearson is not None for r in window_rows):
         save(
             _window_ablation(window_rows),
             "window_ablation",
@@ -211,13 +228,23 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
         )
     if any(r.tokens for r in rows):
         save(
-            _cost_bars(rows, series, colors),
+            _cost_bars(at_view, variants_in_order(at_view, "series"), colors),
             "cost_tokens",
             "Inference cost",
             "Mean tokens per video (bars, left) and VLM calls per video (labels), by "
             "method and frame count (App. F).",
         )
     return written
+
+
+def _primary_setting(rows: list[EpisodeScore]) -> tuple[int, str | None]:
+    """The frame count and view most traces share (ties: more frames, first view)."""
+    frames = [r.num_frames for r in rows]
+    frames0 = max(set(frames), key=lambda n: (frames.count(n), n))
+    views = [r.view for r in rows if r.num_frames == frames0]
+    order = list(dict.fromkeys(views))
+    view0 = max(order, key=lambda v: (views.count(v), -order.index(v)))
+    return frames0, view0
 
 
 def _metadata(ext: str) -> dict[str, str | None]:
@@ -233,11 +260,13 @@ def _new_figure(width: float, height: float) -> Figure:
 def _legend(fig: Figure, ax) -> None:
     handles, labels = ax.get_legend_handles_labels()
     if handles:
+        width_chars = fig.get_figwidth() * 13  # ~characters of 8 pt text per inch
+        per_col = max(len(x) for x in labels) + 5
         fig.legend(
             handles,
             labels,
             loc="outside lower center",
-            ncols=min(len(labels), 4),
+            ncols=max(1, min(len(labels), 4, int(width_chars // per_col))),
             fontsize=8,
             frameon=False,
         )
@@ -278,7 +307,15 @@ def _two_panel_bars(rows, metric, label, variants, colors) -> Figure:
     fig = _new_figure(7.6, 3.3)
     axes = fig.subplots(1, 2, width_ratios=[3, 2])
     _bar_axes(
-        axes[0], rows, metric, label, variants, colors, lambda r: r.task_group, "(a) task group"
+        axes[0],
+        rows,
+        metric,
+        label,
+        variants,
+        colors,
+        lambda r: r.task_group,
+        "(a) task group",
+        "series",
     )
     has_levels = any(r.level is not None for r in rows)
     _bar_axes(
@@ -290,6 +327,7 @@ def _two_panel_bars(rows, metric, label, variants, colors) -> Figure:
         colors,
         (lambda r: f"level {r.level}" if r.level is not None else "n/a"),
         "(b) trajectory level" if has_levels else "(b) level unknown",
+        "series",
     )
     _legend(fig, axes[0])
     return fig
@@ -309,7 +347,7 @@ def _time_diff_hist(rows, variants, colors) -> Figure:
     Overlaid histograms of eight methods hide each other; one row per method keeps every
     distribution visible and still reads like the paper's histogram (App. A, Fig. 3).
     """
-    diffs_by = {v: [d for r in rows if r.variant == v for d in r.qa_time_diffs] for v in variants}
+    diffs_by = {v: [d for r in rows if r.series == v for d in r.qa_time_diffs] for v in variants}
     shown = [v for v in variants if diffs_by[v]]
     fig = _new_figure(6.4, 0.9 + 0.42 * len(shown))
     ax = fig.subplots()
@@ -374,6 +412,8 @@ def _line_by(
         if pts:
             px, m, se, _ = zip(*pts, strict=True)
             ax.errorbar(px, m, yerr=se, marker="o", color=colors[v], label=v, capsize=3)
+    if xs and all(isinstance(x, int) for x in xs):
+        ax.set_xticks(xs)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
@@ -382,7 +422,7 @@ def _line_by(
 
 
 def _window_ablation(rows: list[EpisodeScore]) -> Figure:
-    fig = _new_figure(5.2, 3.0)
+    fig = _new_figure(6.4, 3.0)
     ax = fig.subplots()
     windows = sorted({r.window for r in rows if r.window})
     stats_ = [mean_se([r.pearson for r in rows if r.window == w]) for w in windows]

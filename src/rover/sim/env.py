@@ -115,6 +115,7 @@ class SimEnv:
         # read as "closed" in the facts before the first gripper command)
         self.data.qpos[self._finger_qpos[0]] = 0.04
         self.data.qpos[self._finger_qpos[1]] = -0.04
+        self.data.qacc_warmstart[:] = 0.0
         self.sim.forward()
         self.start_positions = {o.name: self.point(o.name).copy() for o in self.spec.objects}
         return self.get_state()
@@ -125,6 +126,9 @@ class SimEnv:
 
     def set_state(self, state: np.ndarray) -> None:
         self.sim.set_state_from_flattened(np.asarray(state, dtype=np.float64))
+        # the solver's warm start is not part of the state: clear it so stepping from a
+        # restored state is the same whatever ran before (determinism for a seed)
+        self.data.qacc_warmstart[:] = 0.0
         self.sim.forward()
 
     def step(self, action: np.ndarray) -> None:

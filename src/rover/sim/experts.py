@@ -41,6 +41,15 @@ class Phase:
 
 
 @dataclass
+class Retry:
+    """Phases built afresh and run again until `check()` holds (a missed grasp)."""
+
+    build: Callable[[], list[Phase]]
+    check: Callable[[], bool]
+    tries: int = 3
+
+
+@dataclass
 class Demo:
     """One expert demonstration: per-step states (before each action) and actions."""
 
@@ -104,13 +113,18 @@ class Scripted:
             self.sim.step(act)
 
 
-def grasp_yaw(sim: SimEnv, obj: str, period: float, offset: float = 0.0) -> float:
+def grasp_yaw(
+    sim: SimEnv, obj: str, period: float, offset: float = 0.0, near: str | None = None
+) -> float:
     """Gripper yaw that lines the fingers up with the object's faces (mod `period`).
 
     At yaw 0 the fingers close along world y; `offset` turns them to pinch across the
     object's x extent instead (a cereal box is only thin along x).
     """
     geoms = [g for g, o in sim._geom_owner.items() if o == obj and sim.model.geom_contype[g]]
+    if geoms and near is not None:  # the collision geom closest to the grasp point
+        at = sim.point(near)
+        geoms.sort(key=lambda g: float(np.linalg.norm(sim.data.geom_xpos[g] - at)))
     if geoms:  # the collision box's frame (a mesh object's body frame may be turned)
         mat = sim.data.geom_xmat[geoms[0]].reshape(3, 3)
     else:
@@ -131,7 +145,7 @@ def pick_phases(
         return sim.point(where) + np.array([0, 0, grasp_dz])
 
     turn = _YAW_OFFSET.get(obj, 0.0)
-    yaw = (lambda: grasp_yaw(sim, obj, period, turn)) if period else (lambda: 0.0)
+    yaw = (lambda: grasp_yaw(sim, obj, period, turn, point)) if period else (lambda: 0.0)
     hold = [None]
 
     def here() -> np.ndarray:
@@ -187,20 +201,59 @@ _GRASP_DZ = {"milk": 0.045, "cereal": 0.035}
 _YAW_OFFSET = {"cereal": np.pi / 2}
 
 
-def _pick_place_script(sim: SimEnv) -> list[Phase]:
-    phases: list[Phase] = []
+def _pick_retry(sim: SimEnv, obj: str, period, dz: float = 0.0, point=None) -> Retry:
+    return Retry(
+        lambda: pick_phases(sim, obj, period, dz, point),
+        lambda: sim.predicate(f"lifted:{obj}"),
+    )
+
+
+def _pick_place_script(sim: SimEnv) -> list[Phase | Retry]:
+    phases: list[Phase | Retry] = []
     subs = sim.spec.subtasks
     for grasp, move in zip(subs[0::2], subs[1::2], strict=True):
         obj = grasp.object
-        phases += pick_phases(sim, obj, _PERIOD.get(obj), _GRASP_DZ.get(obj, 0.0))
+        phases.append(_pick_retry(sim, obj, _PERIOD.get(obj), _GRASP_DZ.get(obj, 0.0)))
         drop = 0.10 if move.end_signal.startswith("placed") else 0.03
         carry = sim.point(move.goal)[2] + 0.20
         phases += place_phases(sim, move.goal, drop, carry)
     return phases
 
 
-def _lift_script(sim: SimEnv) -> list[Phase]:
-    phases = pick_phases(sim, "cube", _PERIOD["cube"])
+def _nut_script(sim: SimEnv) -> list[Phase | Retry]:
+    grasp, move = sim.spec.subtasks
+    nut = grasp.object
+    phases = [_pick_retry(sim, nut, np.pi, point=f"{nut}:handle")]
+    table_z = float(sim.env.table_offset[2])
+
+    def held_offset() -> np.ndarray:
+        return sim.point("eef") - sim.point(nut)
+
+    def over() -> np.ndarray:
+        g = sim.point(move.goal) + held_offset()
+        return np.array([g[0], g[1], table_z + 0.20])
+
+    def down() -> np.ndarray:
+        g = sim.point(move.goal) + held_offset()
+        return np.array([g[0], g[1], table_z + 0.03])
+
+    rest = [None]
+
+    def let_go() -> np.ndarray:
+        if rest[0] is None:
+            rest[0] = sim.point("eef")
+        return rest[0]
+
+    return phases + [
+        Phase(over, CLOSE, tol=0.01, steps=120, gain=0.6),
+        Phase(down, CLOSE, tol=0.01, steps=60, gain=0.6),
+        Phase(let_go, OPEN, tol=None, steps=8),
+        Phase(lambda: let_go() + np.array([0, 0, 0.08]), OPEN, tol=0.02, steps=20),
+    ]
+
+
+def _lift_script(sim: SimEnv) -> list[Phase | Retry]:
+    phases: list[Phase | Retry] = [_pick_retry(sim, "cube", _PERIOD["cube"])]
     top = [None]
 
     def stay() -> np.ndarray:
@@ -248,11 +301,12 @@ def _door_script(sim: SimEnv) -> list[Phase]:
 # the door handle sits close to the panel: lean the hand away from it (rad about x)
 _TILT = {"door": -0.6}
 
-SCRIPTS: dict[str, Callable[[SimEnv], list[Phase]]] = {
+SCRIPTS: dict[str, Callable[[SimEnv], list[Phase | Retry]]] = {
     "lift": _lift_script,
     "pick_place": _pick_place_script,
     "stack": _pick_place_script,
     "door": _door_script,
+    "nut": _nut_script,
 }
 
 
@@ -261,8 +315,15 @@ def run_expert(sim: SimEnv, seed: int) -> Demo:
     sim.reset(seed)
     script = Scripted(sim)
     script.tilt = _TILT.get(sim.spec.expert, 0.0)
-    for phase in SCRIPTS[sim.spec.expert](sim):
-        script.run(phase)
+    for item in SCRIPTS[sim.spec.expert](sim):
+        if isinstance(item, Retry):
+            for _ in range(item.tries):
+                for phase in item.build():
+                    script.run(phase)
+                if item.check() or len(script.actions) >= sim.spec.max_expert_steps:
+                    break
+        else:
+            script.run(item)
         if len(script.actions) >= sim.spec.max_expert_steps:
             break
     # final hold: the last recorded state is the finished task

@@ -43,8 +43,8 @@ class FreeView:
 # Workspace views for robosuite's table tasks (table top centre ~ (0, 0, 0.8); the robot
 # base stands at x ~ -0.56 looking along +x). Azimuth 180 would look from the front.
 FREE_VIEWS: dict[str, FreeView] = {
-    "left": FreeView(lookat=(0.0, 0.0, 0.95), distance=1.6, azimuth=-120.0, elevation=-28.0),
-    "right": FreeView(lookat=(0.0, 0.0, 0.95), distance=1.6, azimuth=120.0, elevation=-28.0),
+    "left": FreeView(lookat=(0.0, 0.0, 0.9), distance=1.35, azimuth=-125.0, elevation=-32.0),
+    "right": FreeView(lookat=(0.0, 0.0, 0.9), distance=1.35, azimuth=125.0, elevation=-32.0),
 }
 VIEW_NAMES = ["wrist", "left", "right"]
 
