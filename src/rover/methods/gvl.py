@@ -65,10 +65,24 @@ async def gather_limited(coros: list, limit: int) -> None:
     sem = asyncio.Semaphore(max(1, limit))
 
     async def one(c):
-        async with sem:
-            await c
+        try:
+            async with sem:
+                await c
+        finally:
+            c.close()  # no-op once awaited; silences "never awaited" when cancelled early
 
-    await asyncio.gather(*(one(c) for c in coros))
+    tasks = [asyncio.ensure_future(one(c)) for c in coros]
+    if not tasks:
+        return
+    # On the first failure cancel the rest and retrieve every outcome, so the user sees
+    # one error and asyncio never logs "exception was never retrieved".
+    done, pending = await asyncio.wait(tasks, return_when=asyncio.FIRST_EXCEPTION)
+    for t in pending:
+        t.cancel()
+    await asyncio.gather(*pending, return_exceptions=True)
+    for t in tasks:
+        if t.done() and not t.cancelled() and t.exception() is not None:
+            raise t.exception()
 
 
 class GVL(Method):

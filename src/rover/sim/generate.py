@@ -11,6 +11,7 @@ seeded by (seed, task, index), so a rerun or a resumed run reproduces the same e
 
 from __future__ import annotations
 
+import atexit
 import multiprocessing as mp
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -92,6 +93,15 @@ class _TaskState:
 
 
 _CACHE: dict[tuple[str, int], _TaskState] = {}
+
+
+@atexit.register
+def _close_renderers() -> None:
+    # free EGL contexts before interpreter teardown (else mujoco prints EGL errors)
+    for ts in _CACHE.values():
+        if ts.renderer is not None:
+            ts.renderer.close()
+    _CACHE.clear()
 
 
 def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskState:
