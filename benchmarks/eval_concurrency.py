@@ -57,17 +57,29 @@ class SleepyVLM:
         )
 
 
-def make_dataset(root: Path, n: int, frames: int, size: int = 64) -> None:
+def smooth_frames(n: int, size: int, seed: int) -> np.ndarray:
+    """A gradient scene with a moving square: compresses like real video, unlike noise."""
+    ramp = np.linspace(0, 160, size, dtype=np.float32)
+    base = np.zeros((size, size, 3), dtype=np.uint8)
+    base[..., 0], base[..., 1] = ramp[None, :], ramp[:, None]
+    base[..., 2] = (seed * 37) % 200
+    frames = np.repeat(base[None], n, axis=0)
+    side = size // 6
+    for t in range(n):
+        x = int((size - side) * t / max(n - 1, 1))
+        frames[t, size // 3 : size // 3 + side, x : x + side] = (240, 60, 40)
+    return frames
+
+
+def make_dataset(root: Path, n: int, frames: int, size: int = 128) -> None:
     write_dataset_info(root, DatasetInfo(name="bench", views=["rgb"]))
-    rng = np.random.default_rng(0)
     for i in range(n):
-        pixels = rng.integers(0, 255, (frames, size, size, 3), dtype=np.uint8)
         ep = Episode(
             id=f"ep{i:02d}",
             task="pick up the can",
             frame_indices=list(range(frames)),
             view_names=["rgb"],
-            views={"rgb": pixels},
+            views={"rgb": smooth_frames(frames, size, i)},
             truth=GroundTruth(progress=[t / (frames - 1) for t in range(frames)]),
         )
         write_episode(root, ep)
@@ -99,6 +111,28 @@ async def timed_run(
     return time.perf_counter() - start
 
 
+class LoopWatch:
+    """Measures the event loop's longest stall: a 5 ms heartbeat and how late it wakes."""
+
+    def __init__(self) -> None:
+        self.worst = 0.0
+        self._task: asyncio.Task | None = None
+
+    async def _beat(self) -> None:
+        while True:
+            t = time.perf_counter()
+            await asyncio.sleep(0.005)
+            self.worst = max(self.worst, time.perf_counter() - t - 0.005)
+
+    def __enter__(self) -> LoopWatch:
+        self._task = asyncio.get_running_loop().create_task(self._beat())
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._task is not None:
+            self._task.cancel()
+
+
 async def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", type=int, default=32)
@@ -121,6 +155,7 @@ async def main() -> None:
         "slowest single (s)",
         "ratio",
         "target <= 1.2",
+        "longest loop stall (ms)",
     ):
         table.add_column(col, justify="right")
     with tempfile.TemporaryDirectory() as tmp:
@@ -134,7 +169,8 @@ async def main() -> None:
                 singles.append(await timed_run(ds, out, SleepyVLM(args.delay), 1, method, eid))
             vlm = SleepyVLM(args.delay)
             out = Path(tmp) / f"{method}-all"
-            wall = await timed_run(ds, out, vlm, args.concurrency, method)
+            with LoopWatch() as watch:
+                wall = await timed_run(ds, out, vlm, args.concurrency, method)
             slowest = max(singles)
             ratio = wall / slowest
             table.add_row(
@@ -146,8 +182,9 @@ async def main() -> None:
                 f"{slowest:.2f}",
                 f"{ratio:.2f}",
                 "ok" if ratio <= 1.2 else "MISSED",
+                f"{1000 * watch.worst:.0f}",
             )
-    Console(width=120).print(table)
+    Console(width=150).print(table)
 
 
 if __name__ == "__main__":

@@ -83,6 +83,8 @@ def _trace(
             first_frame=0,
             last_frame=last,
             outcome="complete",
+            planned_subtasks=["grasp the <b>can</b>", "place the can in the bin"],
+            calls=3,
             children=[
                 LineNode(
                     id=1,

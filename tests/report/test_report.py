@@ -65,6 +65,7 @@ def _check_escaping(page: str) -> None:
     assert str(escape("<script>document.title='pwned'</script>")) in page
     # subtasks in the reasoning tree are model text too
     assert "grasp the &lt;b&gt;can&lt;/b&gt;" in page
+    assert "plan: grasp the &lt;b&gt;can&lt;/b&gt; → place the can in the bin" in page
 
 
 def _check_oracle_labels(page: str) -> None:
@@ -125,7 +126,7 @@ def test_missing_run_dir_is_an_input_error(tmp_path: Path) -> None:
 
 
 def test_sweep_figures_from_a_real_eval_run(make_run, tmp_path: Path) -> None:
-    """Frame-count and window sweeps (App. H, M) through the evaluation runner itself."""
+    """Frame-count and window sweeps (App. H, M) and App. G strata, via the real runner."""
     import asyncio
 
     from rover.eval.runner import EvalOptions, run_eval
@@ -145,6 +146,8 @@ def test_sweep_figures_from_a_real_eval_run(make_run, tmp_path: Path) -> None:
     index = build_report(tmp_path / "sweep")
     figures = {p.name for p in (index.parent / "figures").iterdir()}
     assert {"pearson_by_frame_count.svg", "window_ablation.svg"} <= figures
+    # frame-level strata (App. G) come from the run's metrics.json
+    assert {"pearson_by_context_state.svg", "error_rate_by_context_state.svg"} <= figures
     page = index.read_text()
     # the summary lists every configuration; the main figures say which setting they show
     for label in ("ROVER · 5 frames", "ROVER (window 6) · 10 frames", "GVL · 5 frames"):

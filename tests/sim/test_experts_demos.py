@@ -14,8 +14,10 @@ from rover.sim.demos import DemoRecord, read_demos, read_env_args, write_demos
 
 def test_robomimic_layout_round_trip(tmp_path):
     path = tmp_path / "demos.hdf5"
-    recs = [DemoRecord(f"demo_{i}", np.full((5, 4), i, float), np.zeros((5, 7)),
-                       ep_meta={"seed": i}) for i in (0, 1, 10, 2)]
+    recs = [
+        DemoRecord(f"demo_{i}", np.full((5, 4), i, float), np.zeros((5, 7)), ep_meta={"seed": i})
+        for i in (0, 1, 10, 2)
+    ]
     write_demos(path, "Lift", {"use_latch": False}, recs)
     with h5py.File(path) as f:
         env_args = json.loads(f["data"].attrs["env_args"])

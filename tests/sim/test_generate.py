@@ -11,6 +11,7 @@ import sys
 import pytest
 from typer.testing import CliRunner
 
+from rover.errors import InputError
 from rover.io.dataset import episode_ids, load_dataset, read_episode
 from rover.sim import bundled_dataset_path
 from rover.sim.validate import validate_dataset
@@ -33,7 +34,9 @@ def test_unknown_task_is_one_line_error(tmp_path):
     env = dict(os.environ, PYTHONWARNINGS="ignore")
     res = subprocess.run(
         [sys.executable, "-m", "rover.cli", "generate", "--tasks", "Nope", "--out", str(tmp_path)],
-        capture_output=True, text=True, env=env,
+        capture_output=True,
+        text=True,
+        env=env,
     )
     assert res.returncode != 0
     lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
@@ -47,9 +50,25 @@ def test_generate_tiny_and_resume(tmp_path):
     from rover.cli import app
 
     out = tmp_path / "ds"
-    args = ["generate", "--tasks", "Lift", "--per-level", "1", "--levels", "1,last",
-            "--frames", "8", "--size", "64", "--views", "left,wrist", "--demos", "1",
-            "--out", str(out)]
+    args = [
+        "generate",
+        "--tasks",
+        "Lift",
+        "--per-level",
+        "1",
+        "--levels",
+        "1,last",
+        "--frames",
+        "8",
+        "--size",
+        "64",
+        "--views",
+        "left,wrist",
+        "--demos",
+        "1",
+        "--out",
+        str(out),
+    ]
     res = CliRunner().invoke(app, args)
     assert res.exit_code == 0, res.output
     ids = episode_ids(out)
@@ -72,3 +91,32 @@ def test_generate_tiny_and_resume(tmp_path):
     assert (out / "episodes" / "Lift-L1-000" / "episode.json").stat().st_mtime_ns == kept
     assert read_episode(out, "Lift-L4-000", load_frames=False).truth.progress == before
     assert not (out / "episodes" / "Lift-L4-000.part").exists()
+
+
+@pytest.mark.sim
+def test_source_hdf5_demos_drive_generation(tmp_path, sim_env):
+    """A robomimic-layout file with no rover metadata (as a user's file would be)."""
+    from rover.sim.demos import DemoRecord, write_demos
+    from rover.sim.experts import run_expert
+    from rover.sim.generate import GenerateConfig, generate
+
+    demo = run_expert(sim_env("Lift"), 5)
+    src = tmp_path / "user.hdf5"
+    write_demos(src, "Lift", {}, [DemoRecord("demo_0", demo.states, demo.actions)])
+    cfg = GenerateConfig(
+        tasks=["Lift"],
+        per_level=1,
+        levels=["last"],
+        frames=4,
+        views=["left"],
+        size=32,
+        source_hdf5=str(src),
+    )
+    assert generate(cfg, tmp_path / "ds") == ["Lift-L4-000"]
+    ep = load_dataset(tmp_path / "ds")[0]
+    assert ep.truth.progress[-1] >= 0.95 and validate_dataset([ep]) == []
+    wrong = tmp_path / "door.hdf5"
+    write_demos(wrong, "Door", {}, [DemoRecord("demo_0", demo.states, demo.actions)])
+    cfg = cfg.model_copy(update={"source_hdf5": str(wrong)})
+    with pytest.raises(InputError, match="demonstrations of 'Door'"):
+        generate(cfg, tmp_path / "ds2")

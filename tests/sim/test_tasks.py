@@ -51,7 +51,12 @@ def test_task_deterministic_and_expert_succeeds(name, sim_env):
     assert not np.array_equal(a, sim.reset(4))  # the scene is randomised per seed
     # every named point the value function reads resolves to a finite position
     for sub in spec.subtasks:
-        for p in [*sub.robot_points, *sub.object_points, sub.object, *([sub.goal] if sub.goal else [])]:
+        for p in [
+            *sub.robot_points,
+            *sub.object_points,
+            sub.object,
+            *([sub.goal] if sub.goal else []),
+        ]:
             assert np.all(np.isfinite(sim.point(p)))
     assert sim.entity_positions().shape == (1 + len(spec.objects), 3)
     demo = run_expert(sim, 3)

@@ -202,7 +202,7 @@ def _print_main_table(metrics: dict) -> None:
     headers, rows = main_rows(metrics, compact=True)
     table = Table(title="rover eval: mean over videos (± SE in summary.md)")
     for h in headers:
-        table.add_column(h, overflow="fold")
+        table.add_column(h, overflow="fold", no_wrap=h == "Method")
     for r in rows:
         table.add_row(*r)
     Console().print(table)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import time
 from pathlib import Path
+from typing import Annotated
 
 import typer
 from rich.console import Console
@@ -18,21 +19,22 @@ def _split(value: str) -> list[str]:
 
 
 def generate_command(
-    out: Path = typer.Option(..., "--out", "-o", help="Dataset directory to write (resumed)."),
-    tasks: str = typer.Option("Lift", "--tasks", help="Comma-separated task names."),
-    per_level: int = typer.Option(3, "--per-level", help="Videos per level per task."),
-    levels: str = typer.Option("all", "--levels", help="Levels: 'all' or e.g. '1,3,last'."),
-    frames: int = typer.Option(
-        0, "--frames", help="Frames per video (0: 30 atomic / 60 composite; max 240)."
-    ),
-    views: str = typer.Option("left,wrist", "--views", help="Views: wrist, left, right."),
-    size: int = typer.Option(256, "--size", help="Frame width and height in px."),
-    seed: int = typer.Option(0, "--seed", help="Seed: same seed, same dataset."),
-    workers: int = typer.Option(1, "--workers", help="Parallel worker processes."),
-    demos: int = typer.Option(3, "--demos", help="Expert demonstrations per task."),
-    source_hdf5: Path | None = typer.Option(
-        None, "--source-hdf5", help="robomimic/RoboCasa HDF5 to use as expert demos."
-    ),
+    out: Annotated[Path, typer.Option("--out", "-o", help="Dataset directory (resumed).")],
+    tasks: Annotated[str, typer.Option(help="Comma-separated task names.")] = "Lift",
+    per_level: Annotated[int, typer.Option(help="Videos per level per task.")] = 3,
+    levels: Annotated[str, typer.Option(help="Levels: 'all' or e.g. '1,3,last'.")] = "all",
+    frames: Annotated[
+        int, typer.Option(help="Frames per video (0: 30 atomic / 60 composite; max 240).")
+    ] = 0,
+    views: Annotated[str, typer.Option(help="Views: wrist, left, right.")] = "left,wrist",
+    size: Annotated[int, typer.Option(help="Frame width and height in px.")] = 256,
+    seed: Annotated[int, typer.Option(help="Seed: same seed, same dataset.")] = 0,
+    workers: Annotated[int, typer.Option(help="Parallel worker processes.")] = 1,
+    demos: Annotated[int, typer.Option(help="Expert demonstrations per task.")] = 3,
+    source_hdf5: Annotated[
+        Path | None,
+        typer.Option("--source-hdf5", help="robomimic/RoboCasa HDF5 to use as expert demos."),
+    ] = None,
 ) -> None:
     """Generate perturbed robosuite videos with ground-truth progress, facts, events and QA."""
     from rover.sim.generate import GenerateConfig, generate

@@ -62,8 +62,13 @@ def _objects(sub: Subtask) -> list[str]:
 
 
 def _mentions(text: str, obj: str) -> bool:
-    text = text.lower()
-    return any(tok in text for tok in obj.split() if len(tok) > 2 and not tok.isdigit())
+    """Does `text` name `obj` (any of its words, as whole words, plural allowed)?"""
+    words = set(re.findall(r"[a-z0-9]+", text.lower()))
+    return any(
+        tok in words or tok + "s" in words
+        for tok in re.findall(r"[a-z0-9]+", obj.lower())
+        if len(tok) > 2 and not tok.isdigit()
+    )
 
 
 def _lines(node: LineNode | None) -> list[tuple[LineNode, list[LineNode], list[LineNode]]]:
@@ -88,7 +93,7 @@ def video_errors(trace: Trace, episode: Episode, judgements: Judgements | None) 
     """0/1 per error type for one video (None where the rule does not apply)."""
     out: dict[str, Any] = {k: None for k in ERROR_TYPES}
     bad = {v.index for v in judgements.verdicts if v.verdict == "false"} if judgements else set()
-    if judgements is not None:
+    if judgements is not None and judgements.has_facts:
         out["perception"] = int(bool(bad))
     if episode.truth is not None:
         a = align(trace, episode)

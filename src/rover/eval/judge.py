@@ -40,11 +40,12 @@ class Judgements(BaseModel):
     verdicts: list[FrameVerdictRecord]
     calls: int = 0
     total_tokens: int = 0
+    has_facts: bool = True  # False for episodes without simulator facts (real videos)
 
     def rates(self) -> tuple[float, float, int]:
-        """(error rate, success rate, judged frames); rates are NaN with no frames."""
+        """(error rate, success rate, judged frames); NaN without frames or facts."""
         n = len(self.verdicts)
-        if n == 0:
+        if n == 0 or not self.has_facts:
             return float("nan"), float("nan"), 0
         err = sum(v.verdict == "false" for v in self.verdicts) / n
         ok = sum(v.verdict == "true" for v in self.verdicts) / n
@@ -114,6 +115,10 @@ def _frames(trace: Trace, episode: Episode) -> list[tuple[int, int, str | None, 
     return out
 
 
+def _has_facts(episode: Episode) -> bool:
+    return episode.truth is not None and episode.truth.facts is not None
+
+
 def rule_judge_trace(trace: Trace, episode: Episode, variant: str) -> Judgements:
     """Judge every frame of a trace with the offline rule judge."""
     verdicts = []
@@ -129,7 +134,13 @@ def rule_judge_trace(trace: Trace, episode: Episode, variant: str) -> Judgements
                 reason=j.reason,
             )
         )
-    return Judgements(episode_id=episode.id, variant=variant, judge="rule", verdicts=verdicts)
+    return Judgements(
+        episode_id=episode.id,
+        variant=variant,
+        judge="rule",
+        verdicts=verdicts,
+        has_facts=_has_facts(episode),
+    )
 
 
 async def llm_judge_trace(
@@ -173,4 +184,5 @@ async def llm_judge_trace(
         verdicts=list(verdicts),
         calls=usage["calls"],
         total_tokens=usage["tokens"],
+        has_facts=_has_facts(episode),
     )

@@ -27,6 +27,7 @@ class Asserted:
     """What one frame description claims about the scene."""
 
     text: str = ""
+    gripper: str | None = None  # "open" / "closed" when the description says
     held: set[str] = field(default_factory=set)
     released: bool = False  # "not holding anything" / "gripper is empty"
     not_held: set[str] = field(default_factory=set)
@@ -45,7 +46,9 @@ def asserted_states(descriptions: list[str | None]) -> list[Asserted]:
         a = Asserted(text=d or "")
         for c in extract_claims(d):
             s = c.subject or ""
-            if c.kind == "holding":
+            if c.kind == "gripper":
+                a.gripper = str(c.value)
+            elif c.kind == "holding":
                 (a.held.add if c.value else a.not_held.add)(s)
             elif c.kind == "holding_any":
                 a.released = a.released or not c.value
@@ -158,7 +161,8 @@ def _event_here(ev: str, obj: str, target: str | None, a: Asserted, was_held: bo
     if ev == "contact":
         return _has(a.touched, obj) or _has(a.held, obj)
     if ev == "grasp":
-        return _has(a.held, obj)
+        # held, or the gripper closed while touching it (how the simulator defines a grasp)
+        return _has(a.held, obj) or (a.gripper == "closed" and _has(a.touched, obj))
     if ev == "pick_up":
         return _get(a.lifted, obj) is True or (
             _has(a.held, obj) and bool(_LIFT_WORDS.search(a.text))

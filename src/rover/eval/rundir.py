@@ -65,6 +65,7 @@ class RunDir:
 
     def __init__(self, root: Path) -> None:
         self.root = Path(root)
+        self._log: Any = None
 
     # --- paths ------------------------------------------------------------------------
     @property
@@ -136,9 +137,15 @@ class RunDir:
             "time": round(time.time(), 3),
             **extra,
         }
-        with open(self.root / UNITS_LOG, "a", encoding="utf-8") as fh:
-            fh.write(json.dumps(line) + "\n")
-            fh.flush()
+        if self._log is None:
+            self._log = open(self.root / UNITS_LOG, "a", encoding="utf-8")  # noqa: SIM115
+        self._log.write(json.dumps(line) + "\n")
+        self._log.flush()  # into the OS at once: a SIGKILL loses nothing written here
+
+    def close(self) -> None:
+        if self._log is not None:
+            self._log.close()
+            self._log = None
 
     def record_error(self, episode_id: str, variant_id: str, stage: str, error: str) -> None:
         write_json_atomic(

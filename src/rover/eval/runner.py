@@ -37,6 +37,7 @@ from rover.eval.rundir import RunDir, write_json_atomic
 from rover.eval.variants import Variant, expand_variants
 from rover.methods.trace import Trace
 from rover.vlm.config import BackendConfig
+from rover.vlm.types import EncodedImage, ImageEncoding
 
 OFF = ("none", "off", "skip")
 
@@ -186,7 +187,10 @@ class Runner:
     async def run(self) -> RunState:
         sem = asyncio.Semaphore(max(1, self.opts.concurrency))
         self.on_update(self.state)
-        await asyncio.gather(*(self._episode(ref, sem) for ref in self.refs))
+        try:
+            await asyncio.gather(*(self._episode(ref, sem) for ref in self.refs))
+        finally:
+            self.rundir.close()
         await asyncio.to_thread(self.rundir.write_errors_file)
         return self.state
 
@@ -201,7 +205,7 @@ class Runner:
             return
         async with sem:
             try:
-                meta, loaded = await asyncio.to_thread(load_for_variants, ref, pending)
+                meta, loaded = await asyncio.to_thread(self._load, ref, pending)
                 if not self.rundir.episode_path(ref.id).exists():
                     await asyncio.to_thread(
                         write_json_atomic, self.rundir.episode_path(ref.id), meta
@@ -215,6 +219,23 @@ class Runner:
             await asyncio.gather(*(self._unit(ref, meta, loaded, v) for v in pending))
         self.state.episodes_done += 1
         self.on_update(self.state)
+
+    def _load(self, ref: EpisodeRef, pending: list[Variant]) -> tuple[Episode, Episode]:
+        """Decode the episode and JPEG-encode its frames, off the event loop (a thread).
+
+        Methods encode each frame they send through `EncodedImage.from_any`, which memoises
+        by pixels and settings; encoding here first means the loop only finds them ready.
+        """
+        meta, loaded = load_for_variants(ref, pending)
+        encodings: dict[str, ImageEncoding] = {}
+        for v in pending:
+            enc = getattr(self.vlms[v.backend], "image_encoding", None) or ImageEncoding()
+            encodings[enc.model_dump_json()] = enc
+        for arr in loaded.views.values():
+            for enc in encodings.values():
+                for frame in arr:
+                    EncodedImage.from_any(frame, enc)
+        return meta, loaded
 
     async def _fail(self, ref: EpisodeRef, v: Variant, stage: str, exc: BaseException) -> None:
         msg = str(exc) if isinstance(exc, RoverError) else f"{type(exc).__name__}: {exc}"
@@ -270,7 +291,7 @@ class Runner:
     async def _judge(self, ref: EpisodeRef, episode: Episode, trace: Trace, v: Variant) -> None:
         self.rundir.log_unit(ref.id, v.id, "judge", "start")
         if self.judge_vlm is None:
-            result = rule_judge_trace(trace, episode, v.id)
+            result = await asyncio.to_thread(rule_judge_trace, trace, episode, v.id)
         else:
             vlm = self.judge_vlm.bind(episode)
             result = await llm_judge_trace(trace, episode, v.id, vlm, self.opts.judge)
@@ -284,7 +305,7 @@ class Runner:
     async def _qa(self, ref: EpisodeRef, episode: Episode, trace: Trace, v: Variant) -> None:
         self.rundir.log_unit(ref.id, v.id, "qa", "start")
         if self.answer_vlm is None:
-            result = rule_answer_trace(trace, episode, v.id)
+            result = await asyncio.to_thread(rule_answer_trace, trace, episode, v.id)
         else:
             vlm = self.answer_vlm.bind(episode)
             result = await llm_answer_trace(trace, episode, v.id, vlm, self.opts.answerer)

@@ -89,7 +89,7 @@ def trace_strata(
         "nonexpert": nonexpert_bin(share),
         "view": trace.view or episode.view,
         "backend": variant.get("backend"),
-        "frames": variant.get("frames") or episode.num_frames,
+        "frames": episode.num_frames,  # what the method saw (a sweep value may exceed it)
         "window": variant.get("window"),
         "dataset": dataset,
     }

@@ -37,7 +37,7 @@ def build_report(
     out.mkdir(parents=True, exist_ok=True)
     rows = score_run(run)
     colors = variant_colors(rows)
-    figures = write_figures(rows, out / "figures", oracle=run.oracle)
+    figures = write_figures(rows, out / "figures", oracle=run.oracle, aggregates=run.aggregates)
     episodes = build_episode_views(run, out, colors, max_episodes=max_episodes)
     path = render_page(run, rows, figures, episodes, colors, out)
     log.info("report written to %s", path)

@@ -8,36 +8,16 @@ ablation...), so a small run yields a short, honest report rather than empty axe
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 from matplotlib import rc_context
 from matplotlib.figure import Figure
 
-from rover.eval.stratify import nonexpert_bin
-from rover.report.scores import EpisodeScore, mean_se, variants_in_order
+from rover.report import charts
+from rover.report.charts import PALETTE
+from rover.report.scores import EpisodeScore, variants_in_order
 
-PALETTE = [
-    "#1f77b4",
-    "#d62728",
-    "#2ca02c",
-    "#ff7f0e",
-    "#9467bd",
-    "#8c564b",
-    "#e377c2",
-    "#7f7f7f",
-    "#bcbd22",
-    "#17becf",
-    "#393b79",
-    "#e7969c",
-    "#637939",
-    "#ffbb78",
-    "#c5b0d5",
-    "#8c6d31",
-]
 ORACLE_NOTE = "ORACLE OUTPUT: answers come from simulator ground truth, not a VLM"
 
 
@@ -52,7 +32,7 @@ class FigureFile:
     svg: str
 
 
-# metric attribute -> (axis label, figure title, caption, higher is better)
+# metric attribute -> (axis label, figure title, caption)
 METRICS: dict[str, tuple[str, str, str]] = {
     "pearson": (
         "Pearson r with ground truth",
@@ -101,6 +81,23 @@ METRICS: dict[str, tuple[str, str, str]] = {
 }
 
 
+# frame-level strata read from metrics.json: metric -> (table, axis label, scale, title)
+STRATA: dict[str, tuple[str, str, float, str]] = {
+    "pearson": (
+        "progress",
+        "Pearson r with ground truth",
+        1.0,
+        "Progress by context length and state type",
+    ),
+    "error_rate": (
+        "reasoning",
+        "Reasoning error rate (%)",
+        100.0,
+        "Frame reasoning by context length and state type",
+    ),
+}
+
+
 def variant_colors(rows: list[EpisodeScore]) -> dict[str, str]:
     """One fixed colour per configuration (and per series), shared by figures and viewer."""
     colors = {v: PALETTE[i % len(PALETTE)] for i, v in enumerate(variants_in_order(rows))}
@@ -109,10 +106,16 @@ def variant_colors(rows: list[EpisodeScore]) -> dict[str, str]:
     return colors
 
 
-def write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[FigureFile]:
-    """Draw every figure the rows support into `out` (PNG + SVG); return what was written."""
+def write_figures(
+    rows: list[EpisodeScore], out: Path, oracle: bool, aggregates: list[dict] | None = None
+) -> list[FigureFile]:
+    """Draw every figure the rows support into `out` (PNG + SVG); return what was written.
+
+    `aggregates` are metrics.json's long-form rows; they supply the frame-level strata
+    (context length, state type) that per-trace rows cannot.
+    """
     with rc_context(_STYLE):
-        return _write_figures(rows, out, oracle)
+        return _write_figures(rows, out, oracle, aggregates or [])
 
 
 _STYLE = {
@@ -126,7 +129,9 @@ _STYLE = {
 }
 
 
-def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[FigureFile]:
+def _write_figures(
+    rows: list[EpisodeScore], out: Path, oracle: bool, aggregates: list[dict]
+) -> list[FigureFile]:
     out.mkdir(parents=True, exist_ok=True)
     colors = variant_colors(rows)
     written: list[FigureFile] = []
@@ -155,12 +160,39 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
     for metric, (label, title, caption) in METRICS.items():
         if not any(getattr(r, metric) is not None for r in main):
             continue
-        fig = _two_panel_bars(main, metric, label, series, colors)
+        fig = charts.two_panel_bars(main, metric, label, series, colors)
         save(fig, f"{metric}_by_group_level", title, caption + note)
+
+    series_of = {r.variant_id: r.series for r in main}
+    for metric, (table, label, scale, title) in STRATA.items():
+        agg = [
+            {
+                "series": series_of[a["variant"]],
+                "by": a["by"],
+                "group": str(a["group"]),
+                "mean": a["mean"] * scale,
+                "se": None if a.get("se") is None else a["se"] * scale,
+            }
+            for a in aggregates
+            if a.get("table") == table
+            and a.get("metric") == metric
+            and a.get("by") in ("context", "state_type")
+            and a.get("variant") in series_of
+            and isinstance(a.get("mean"), int | float)
+        ]
+        if agg:
+            save(
+                charts.strata_bars(agg, label, series, colors),
+                f"{metric}_by_context_state",
+                title,
+                "Mean and standard error over videos, per frame stratum: how many "
+                "frames the method had in context when it predicted a frame, and the state "
+                "type at that frame (App. G). From metrics.json." + note,
+            )
 
     if any(r.qa_time_diffs for r in main):
         save(
-            _time_diff_hist(main, series, colors),
+            charts.time_diff_hist(main, series, colors),
             "qa_temporal_distance",
             "Video QA: temporal distance",
             "Frames between when a method's descriptions say an event happened and when it "
@@ -168,12 +200,12 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
         )
     if any(r.non_expert_share is not None for r in main):
         save(
-            _line_by(
+            charts.line_by(
                 main,
                 series,
                 colors,
                 "frame_corr",
-                _non_expert_bin,
+                charts.non_expert_bin,
                 "Share of non-expert frames",
                 "Correlation with frame number",
                 attr="series",
@@ -186,7 +218,7 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
         )
     if len({r.num_frames for r in at_view}) > 1 and any(r.pearson is not None for r in at_view):
         save(
-            _line_by(
+            charts.line_by(
                 at_view,
                 variants_in_order(at_view, "series"),
                 colors,
@@ -202,7 +234,7 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
             "are sampled with more frames (App. H).",
         )
     if len({r.view for r in at_frames}) > 1 and any(r.pearson is not None for r in at_frames):
-        fig = _bars(
+        fig = charts.bars(
             at_frames,
             "pearson",
             "Pearson r with ground truth",
@@ -221,14 +253,14 @@ def _write_figures(rows: list[EpisodeScore], out: Path, oracle: bool) -> list[Fi
     window_rows = [r for r in main if r.method == "rover" and r.window]
     if len({r.window for r in window_rows}) > 1 and any(r.pearson is not None for r in window_rows):
         save(
-            _window_ablation(window_rows),
+            charts.window_ablation(window_rows),
             "window_ablation",
             "Ablation: window size",
             "Correlation with ground truth of ROVER as its sliding window grows (App. M).",
         )
     if any(r.tokens for r in rows):
         save(
-            _cost_bars(at_view, variants_in_order(at_view, "series"), colors),
+            charts.cost_bars(at_view, variants_in_order(at_view, "series"), colors),
             "cost_tokens",
             "Inference cost",
             "Mean tokens per video (bars, left) and VLM calls per video (labels), by "
@@ -250,218 +282,3 @@ def _primary_setting(rows: list[EpisodeScore]) -> tuple[int, str | None]:
 def _metadata(ext: str) -> dict[str, str | None]:
     # keep files reproducible: no creation dates in them
     return {"Date": None} if ext == "svg" else {}
-
-
-def _new_figure(width: float, height: float) -> Figure:
-    # sized for a ~560 px wide slot on the page, so 9-10 pt text stays readable there
-    return Figure(figsize=(width, height), layout="constrained")
-
-
-def _legend(fig: Figure, ax) -> None:
-    handles, labels = ax.get_legend_handles_labels()
-    if handles:
-        width_chars = fig.get_figwidth() * 13  # ~characters of 8 pt text per inch
-        per_col = max(len(x) for x in labels) + 5
-        fig.legend(
-            handles,
-            labels,
-            loc="outside lower center",
-            ncols=max(1, min(len(labels), 4, int(width_chars // per_col))),
-            fontsize=8,
-            frameon=False,
-        )
-
-
-def _bar_axes(ax, rows, metric, label, variants, colors, key, xlabel, attr="variant") -> None:
-    groups = sorted({key(r) for r in rows if getattr(r, metric) is not None}, key=str)
-    if not groups:
-        ax.set_visible(False)
-        return
-    width = 0.8 / max(len(variants), 1)
-    x = np.arange(len(groups))
-    for i, v in enumerate(variants):
-        stats_ = [
-            mean_se([getattr(r, metric) for r in rows if getattr(r, attr) == v and key(r) == g])
-            for g in groups
-        ]
-        means = [s[0] for s in stats_]
-        ses = [s[1] for s in stats_]
-        ax.bar(
-            x + (i - (len(variants) - 1) / 2) * width,
-            means,
-            width,
-            yerr=ses,
-            color=colors[v],
-            label=v,
-            capsize=2,
-            error_kw={"elinewidth": 0.8},
-        )
-    ax.set_xticks(x, [str(g) for g in groups], rotation=20 if len(groups) > 4 else 0)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(label)
-    ax.axhline(0, color="black", linewidth=0.6)
-    ax.grid(axis="y", alpha=0.3)
-
-
-def _two_panel_bars(rows, metric, label, variants, colors) -> Figure:
-    fig = _new_figure(7.6, 3.3)
-    axes = fig.subplots(1, 2, width_ratios=[3, 2])
-    _bar_axes(
-        axes[0],
-        rows,
-        metric,
-        label,
-        variants,
-        colors,
-        lambda r: r.task_group,
-        "(a) task group",
-        "series",
-    )
-    has_levels = any(r.level is not None for r in rows)
-    _bar_axes(
-        axes[1],
-        rows,
-        metric,
-        label,
-        variants,
-        colors,
-        (lambda r: f"level {r.level}" if r.level is not None else "n/a"),
-        "(b) trajectory level" if has_levels else "(b) level unknown",
-        "series",
-    )
-    _legend(fig, axes[0])
-    return fig
-
-
-def _bars(rows, metric, label, variants, colors, key, xlabel, attr="variant") -> Figure:
-    fig = _new_figure(6.4, 3.2)
-    ax = fig.subplots()
-    _bar_axes(ax, rows, metric, label, variants, colors, key, xlabel, attr)
-    _legend(fig, ax)
-    return fig
-
-
-def _time_diff_hist(rows, variants, colors) -> Figure:
-    """Per method: a histogram as a row of dots (one per question) over a box of quartiles.
-
-    Overlaid histograms of eight methods hide each other; one row per method keeps every
-    distribution visible and still reads like the paper's histogram (App. A, Fig. 3).
-    """
-    diffs_by = {v: [d for r in rows if r.series == v for d in r.qa_time_diffs] for v in variants}
-    shown = [v for v in variants if diffs_by[v]]
-    fig = _new_figure(6.4, 0.9 + 0.42 * len(shown))
-    ax = fig.subplots()
-    rng = np.random.default_rng(0)  # jitter only spreads overlapping dots; fixed for stability
-    for i, v in enumerate(shown):
-        ds = np.asarray(diffs_by[v], dtype=float)
-        y = len(shown) - 1 - i
-        q1, med, q3 = np.percentile(ds, [25, 50, 75])
-        ax.barh(
-            y,
-            max(q3 - q1, 0.2),
-            left=q1 if q3 > q1 else q1 - 0.1,
-            height=0.6,
-            color=colors[v],
-            alpha=0.25,
-            edgecolor=colors[v],
-        )
-        ax.vlines(med, y - 0.3, y + 0.3, color="black", linewidth=1.2)
-        ax.scatter(
-            ds + rng.uniform(-0.15, 0.15, len(ds)),
-            y + rng.uniform(-0.22, 0.22, len(ds)),
-            s=10,
-            color=colors[v],
-            alpha=0.7,
-            zorder=3,
-        )
-    ax.set_yticks(range(len(shown)), list(reversed(shown)))
-    ax.axvline(0, color="black", linewidth=0.8, linestyle="--")
-    ax.set_xlabel("Stated frame - actual frame (negative: stated too early)")
-    ax.grid(axis="x", alpha=0.3)
-    return fig
-
-
-def _non_expert_bin(r: EpisodeScore) -> str | None:
-    return nonexpert_bin(r.non_expert_share)  # the same bins as metrics.json
-
-
-def _line_by(
-    rows,
-    variants,
-    colors,
-    metric: str,
-    key: Callable,
-    xlabel: str,
-    ylabel: str,
-    attr: str = "variant",
-) -> Figure:
-    fig = _new_figure(6.4, 3.2)
-    ax = fig.subplots()
-    xs = sorted({key(r) for r in rows if key(r) is not None})
-    for v in variants:
-        pts = [
-            (
-                x,
-                *mean_se(
-                    [getattr(r, metric) for r in rows if getattr(r, attr) == v and key(r) == x]
-                ),
-            )
-            for x in xs
-        ]
-        pts = [p for p in pts if p[3] > 0]
-        if pts:
-            px, m, se, _ = zip(*pts, strict=True)
-            ax.errorbar(px, m, yerr=se, marker="o", color=colors[v], label=v, capsize=3)
-    if xs and all(isinstance(x, int) for x in xs):
-        ax.set_xticks(xs)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.grid(alpha=0.3)
-    _legend(fig, ax)
-    return fig
-
-
-def _window_ablation(rows: list[EpisodeScore]) -> Figure:
-    fig = _new_figure(6.4, 3.0)
-    ax = fig.subplots()
-    windows = sorted({r.window for r in rows if r.window})
-    stats_ = [mean_se([r.pearson for r in rows if r.window == w]) for w in windows]
-    ax.errorbar(
-        windows,
-        [s[0] for s in stats_],
-        yerr=[s[1] for s in stats_],
-        marker="o",
-        color=PALETTE[0],
-        capsize=3,
-    )
-    ax.set_xticks(windows)
-    ax.set_xlabel("Sliding window (frames)")
-    ax.set_ylabel("Pearson r with ground truth")
-    ax.grid(alpha=0.3)
-    return fig
-
-
-def _cost_bars(rows, variants, colors) -> Figure:
-    fig = _new_figure(6.8, 3.3)
-    ax = fig.subplots()
-    counts = sorted({r.num_frames for r in rows})
-    width = 0.8 / max(len(variants), 1)
-    x = np.arange(len(counts))
-    for i, v in enumerate(variants):
-        toks = [
-            mean_se([r.tokens for r in rows if r.series == v and r.num_frames == n]) for n in counts
-        ]
-        calls = [
-            mean_se([r.calls for r in rows if r.series == v and r.num_frames == n])[0]
-            for n in counts
-        ]
-        pos = x + (i - (len(variants) - 1) / 2) * width
-        bars = ax.bar(pos, [t[0] for t in toks], width, color=colors[v], label=v)
-        ax.bar_label(
-            bars, [f"{c:.0f}" if not math.isnan(c) else "" for c in calls], fontsize=6, padding=1
-        )
-    ax.set_xticks(x, [f"{n} frames" for n in counts])
-    ax.set_ylabel("Tokens per video (bar labels: calls)")
-    ax.grid(axis="y", alpha=0.3)
-    _legend(fig, ax)
-    return fig

@@ -27,7 +27,7 @@ from rover.methods.trace import Trace
 log = logging.getLogger(__name__)
 
 # files that may name the dataset a run was made from, and the keys that may hold it
-_CONFIG_FILES = ("run.json", "config.json", "manifest.json", "eval.json", "metrics.json")
+_CONFIG_FILES = ("run.json", "config.json", "manifest.json", "eval.json")
 _DATASET_KEYS = ("dataset", "dataset_dir", "dataset_path", "data")
 
 DISPLAY_NAMES = {
@@ -92,6 +92,9 @@ class RunData:
     verdicts: dict[tuple[str, str], dict[int, FrameVerdict]] = field(default_factory=dict)
     qa: dict[tuple[str, str], list[QAResult]] = field(default_factory=dict)
     config: dict[str, Any] = field(default_factory=dict)
+    # metrics.json's long-form aggregate rows, for the frame-level strata (App. G) that
+    # only the evaluation computes; empty when the run has no metrics.json
+    aggregates: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def traces(self) -> list[Trace]:
@@ -167,6 +170,7 @@ def load_run(run_dir: Path, dataset: Path | None = None) -> RunData:
     config = _load_config(run_dir)
     ds = Path(dataset) if dataset is not None else _dataset_from_config(run_dir, config)
     run = RunData(run_dir=run_dir, entries=entries, dataset=ds, config=config)
+    run.aggregates = _load_aggregates(run_dir / "metrics.json")
     if ds is not None:
         if not (ds / DATASET_FILE).exists():
             raise InputError(f"{ds}: not a rover dataset directory (no {DATASET_FILE})")
@@ -213,6 +217,17 @@ def _load_config(run_dir: Path) -> dict[str, Any]:
                 for k, v in raw.items():
                     merged.setdefault(k, v)
     return merged
+
+
+def _load_aggregates(path: Path) -> list[dict[str, Any]]:
+    if not path.exists():
+        return []
+    try:
+        rows = json.loads(path.read_text()).get("aggregates", [])
+    except (json.JSONDecodeError, AttributeError, OSError):
+        log.warning("skipping %s: not readable as metrics", path)
+        return []
+    return [r for r in rows if isinstance(r, dict)]
 
 
 def _dataset_from_config(run_dir: Path, config: dict[str, Any]) -> Path | None:

@@ -22,6 +22,7 @@ class EpisodeScore:
     """Every number the report shows about one trace (one configuration on one episode)."""
 
     variant: str  # display label of the configuration
+    variant_id: str  # the run's variant id (file stem of the trace)
     series: str  # the label without frame count / view
     method: str
     episode_id: str
@@ -58,6 +59,7 @@ def score_entry(run: RunData, entry: TraceEntry) -> EpisodeScore:
     window = trace.params.get("window")
     row = EpisodeScore(
         variant=entry.label,
+        variant_id=entry.variant_id,
         series=entry.series,
         method=trace.method,
         episode_id=trace.episode_id,

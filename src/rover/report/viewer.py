@@ -37,6 +37,8 @@ class TreeNode:
     outcome: str
     final_description: str
     children: list[TreeNode] = field(default_factory=list)
+    plan: list[str] = field(default_factory=list)  # subtasks the model announced, if any
+    calls: int = 0
 
 
 @dataclass
@@ -153,6 +155,8 @@ def _tree(node: LineNode) -> TreeNode:
         outcome=node.outcome.replace("_", " "),
         final_description=node.final_description or "",
         children=[_tree(c) for c in node.children],
+        plan=list(getattr(node, "planned_subtasks", []) or []),
+        calls=int(getattr(node, "calls", 0) or 0),
     )
 
 
@@ -216,7 +220,7 @@ def progress_chart_svg(
             f'<text x="{sx(x):.1f}" y="{height - 10}" text-anchor="middle" '
             f'font-size="11" fill="#555">{x}</text>'
         )
-    for name, color, pts in curves:
+    for name, color, pts in reversed(curves):  # the first method (ROVER) drawn on top
         parts.append(_polyline(pts, sx, sy, html.escape(color, quote=True), 1.8, "", name))
     if truth:
         parts.append(

@@ -15,7 +15,7 @@ import os
 import mujoco
 import numpy as np
 
-from rover.errors import MissingExtraError
+from rover.errors import InputError, MissingExtraError
 from rover.sim.interp import interpolate_state
 from rover.sim.tasks.base import TaskSpec
 
@@ -111,6 +111,8 @@ class SimEnv:
         """Reset to the initial configuration drawn from `seed`; return the flat state."""
         self.env.rng.bit_generator.state = np.random.default_rng(seed).bit_generator.state
         self.env.reset()
+        if self.spec.clear_objects:
+            self.env.clear_objects(self.spec.clear_objects)
         # start with the fingers wide open (robosuite starts them half open, which would
         # read as "closed" in the facts before the first gripper command)
         self.data.qpos[self._finger_qpos[0]] = 0.04
@@ -119,6 +121,18 @@ class SimEnv:
         self.sim.forward()
         self.start_positions = {o.name: self.point(o.name).copy() for o in self.spec.objects}
         return self.get_state()
+
+    def begin(self, state: np.ndarray) -> None:
+        """Start an episode at a saved state (a demo's first state): objects' start
+        positions, which lift heights and some goals are measured from, come from it."""
+        state = np.asarray(state, dtype=np.float64)
+        if state.shape != self.get_state().shape:
+            raise InputError(
+                f"{self.spec.name}: a state of length {state.shape[0]} does not fit this "
+                f"environment (expected {self.get_state().shape[0]}); wrong --source-hdf5?"
+            )
+        self.set_state(state)
+        self.start_positions = {o.name: self.point(o.name).copy() for o in self.spec.objects}
 
     # ------------------------------------------------------------ SimAdapter
     def get_state(self) -> np.ndarray:

@@ -132,6 +132,22 @@ def grasp_yaw(
     return _wrap(_yaw_of(mat) + offset, period)
 
 
+def clear_yaw(sim: SimEnv, obj: str) -> float:
+    """For a round object: the yaw whose fingers land farthest from other objects."""
+    centre = sim.point(obj)[:2]
+    others = [sim.point(o.name)[:2] for o in sim.spec.objects if o.name != obj]
+    if not others:
+        return 0.0
+    best, best_gap = 0.0, -1.0
+    for yaw in np.linspace(0.0, np.pi, 8, endpoint=False):
+        axis = np.array([-np.sin(yaw), np.cos(yaw)])
+        fingers = [centre + 0.05 * axis, centre - 0.05 * axis]
+        gap = min(float(np.linalg.norm(f - p)) for f in fingers for p in others)
+        if gap > best_gap + 1e-3:
+            best, best_gap = _wrap(float(yaw), np.pi), gap
+    return best
+
+
 def pick_phases(
     sim: SimEnv, obj: str, period: float | None, grasp_dz: float = 0.0, point: str | None = None
 ) -> list[Phase]:
@@ -145,7 +161,10 @@ def pick_phases(
         return sim.point(where) + np.array([0, 0, grasp_dz])
 
     turn = _YAW_OFFSET.get(obj, 0.0)
-    yaw = (lambda: grasp_yaw(sim, obj, period, turn, point)) if period else (lambda: 0.0)
+    if period:
+        yaw = lambda: grasp_yaw(sim, obj, period, turn, point)  # noqa: E731
+    else:
+        yaw = lambda: clear_yaw(sim, obj)  # noqa: E731
     hold = [None]
 
     def here() -> np.ndarray:
@@ -161,20 +180,65 @@ def pick_phases(
         Phase(above, OPEN, tol=0.015, steps=80, yaw=yaw),
         Phase(at, OPEN, tol=0.006, steps=40, gain=1.5),
         Phase(freeze, CLOSE, tol=None, steps=10),
-        Phase(lambda: here() + np.array([0, 0, start_z + 0.15 - here()[2]]), CLOSE, 0.02, 60,
-              gain=0.6),
+        Phase(
+            lambda: here() + np.array([0, 0, start_z + 0.15 - here()[2]]), CLOSE, 0.02, 60, gain=0.6
+        ),
     ]
 
 
-def place_phases(sim: SimEnv, goal: str, drop_dz: float, carry_z: float) -> list[Phase]:
-    """Carry over the goal at `carry_z`, lower to `drop_dz` above it, release, retreat."""
+_SIGNS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+
+
+def object_z_range(sim: SimEnv, obj: str) -> tuple[float, float]:
+    """Lowest and highest world z of the object's collision geoms (bounding-box corners)."""
+    low, high = np.inf, -np.inf
+    for g, owner in sim._geom_owner.items():
+        if owner != obj or not sim.model.geom_contype[g]:
+            continue
+        centre, half = sim.model.geom_aabb[g][:3], sim.model.geom_aabb[g][3:]
+        z = ((centre + _SIGNS * half) @ sim.data.geom_xmat[g].reshape(3, 3).T)[:, 2]
+        z = z + sim.data.geom_xpos[g][2]
+        low, high = min(low, float(z.min())), max(high, float(z.max()))
+    if not np.isfinite(low):
+        z = float(sim.point(obj)[2])
+        return z, z
+    return low, high
+
+
+def object_bottom(sim: SimEnv, obj: str) -> float:
+    return object_z_range(sim, obj)[0]
+
+
+def place_phases(
+    sim: SimEnv, goal: str, drop_dz: float, carry_z: float, obj: str | None = None
+) -> list[Phase]:
+    """Carry over the goal at `carry_z`, lower to `drop_dz` above it, release, retreat.
+
+    With `obj`, the goal is a floor (a bin): the held object's bottom is lowered to
+    `drop_dz` above it, however far below the fingers the object reaches.
+    """
+
+    def reach() -> float:  # how far the held object hangs below the grip point
+        if not obj:
+            return 0.0
+        return float(np.clip(sim.point("eef")[2] - object_bottom(sim, obj), 0.0, 0.2))
+
+    held = obj
+    tops = [object_z_range(sim, o.name)[1] for o in sim.spec.objects if o.name != held]
+
+    def safe_z() -> float:  # the load clears every other object
+        return max(tops, default=0.0) + reach() + 0.05
 
     def over() -> np.ndarray:
         g = sim.point(goal)
-        return np.array([g[0], g[1], carry_z])
+        return np.array([g[0], g[1], max(carry_z, g[2] + reach() + 0.12, safe_z())])
+
+    def rise() -> np.ndarray:  # straight up first, then across
+        e = sim.point("eef")
+        return np.array([e[0], e[1], over()[2]])
 
     def down() -> np.ndarray:
-        return sim.point(goal) + np.array([0, 0, drop_dz])
+        return sim.point(goal) + np.array([0, 0, drop_dz + reach()])
 
     rest = [None]
 
@@ -184,6 +248,7 @@ def place_phases(sim: SimEnv, goal: str, drop_dz: float, carry_z: float) -> list
         return rest[0]
 
     return [
+        Phase(rise, CLOSE, tol=0.02, steps=40, gain=0.6),
         Phase(over, CLOSE, tol=0.02, steps=120, gain=0.6),
         Phase(down, CLOSE, tol=0.01, steps=50),
         Phase(freeze, OPEN, tol=None, steps=8),
@@ -192,8 +257,14 @@ def place_phases(sim: SimEnv, goal: str, drop_dz: float, carry_z: float) -> list
 
 
 # grasp symmetry about the vertical axis, per object (None: round, any yaw works)
-_PERIOD = {"cube": np.pi / 2, "red cube": np.pi / 2, "can": None, "milk": np.pi / 2,
-           "bread": np.pi, "cereal": np.pi}
+_PERIOD = {
+    "cube": np.pi / 2,
+    "red cube": np.pi / 2,
+    "can": None,
+    "milk": np.pi / 2,
+    "bread": np.pi,
+    "cereal": np.pi,
+}
 
 
 # tall objects: grasp this far above their centre so the palm clears their top (m)
@@ -214,9 +285,11 @@ def _pick_place_script(sim: SimEnv) -> list[Phase | Retry]:
     for grasp, move in zip(subs[0::2], subs[1::2], strict=True):
         obj = grasp.object
         phases.append(_pick_retry(sim, obj, _PERIOD.get(obj), _GRASP_DZ.get(obj, 0.0)))
-        drop = 0.10 if move.end_signal.startswith("placed") else 0.03
+        into_bin = move.end_signal.startswith("placed")
         carry = sim.point(move.goal)[2] + 0.20
-        phases += place_phases(sim, move.goal, drop, carry)
+        phases += place_phases(
+            sim, move.goal, 0.03, carry, obj=move.object if into_bin else None
+        )
     return phases
 
 
@@ -291,8 +364,16 @@ def _door_script(sim: SimEnv) -> list[Phase]:
         Phase(lambda: handle() + np.array([0, 0, 0.08]), OPEN, tol=0.015, steps=80),
         Phase(handle, OPEN, tol=0.006, steps=40, gain=1.5),
         Phase(freeze, CLOSE, tol=None, steps=10),
-        Phase(pull, CLOSE, tol=None, steps=150, yaw=sim.hinge_angle, track_yaw=True, gain=0.6,
-              done=lambda: sim.hinge_angle() > goal + 0.03),
+        Phase(
+            pull,
+            CLOSE,
+            tol=None,
+            steps=150,
+            yaw=sim.hinge_angle,
+            track_yaw=True,
+            gain=0.6,
+            done=lambda: sim.hinge_angle() > goal + 0.03,
+        ),
         Phase(let_go, OPEN, tol=None, steps=8),
         Phase(lambda: let_go() + np.array([0.0, 0.06, 0.06]), OPEN, tol=0.015, steps=20),
     ]

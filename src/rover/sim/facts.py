@@ -139,12 +139,23 @@ def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
             if spec.bins or "on" in spec.goals or "peg" in spec.goals:
                 events.append(Event(name="place", object=name, frame=place))
         elif name == "door":
-            events.append(Event(name="grasp", object=name, frame=_first(
-                facts, lambda f: f.holding == "door")))
-            events.append(Event(name="open_start", object=name, frame=_first(
-                facts, lambda f: f.articulations.get("door", 0.0) >= OPEN_START)))
-            events.append(Event(name="open_finish", object=name, frame=_first(
-                facts, lambda f: f.articulations.get("door", 0.0) >= OPEN_FINISH)))
+            events.append(
+                Event(name="grasp", object=name, frame=_first(facts, lambda f: f.holding == "door"))
+            )
+            events.append(
+                Event(
+                    name="open_start",
+                    object=name,
+                    frame=_first(facts, lambda f: f.articulations.get("door", 0.0) >= OPEN_START),
+                )
+            )
+            events.append(
+                Event(
+                    name="open_finish",
+                    object=name,
+                    frame=_first(facts, lambda f: f.articulations.get("door", 0.0) >= OPEN_FINISH),
+                )
+            )
     return events
 
 

@@ -95,7 +95,6 @@ class _TaskState:
 _CACHE: dict[tuple[str, int], _TaskState] = {}
 
 
-@atexit.register
 def _close_renderers() -> None:
     # free EGL contexts before interpreter teardown (else mujoco prints EGL errors)
     for ts in _CACHE.values():
@@ -115,16 +114,26 @@ def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskSta
         sim = SimEnv(spec)
         demos = []
         for rec in read_demos(demo_dir / f"{spec.name}.hdf5"):
-            sim.reset(int(rec.ep_meta.get("seed", 0)))
+            seed = int(rec.ep_meta.get("seed", 0))
+            sim.reset(seed)
+            sim.begin(rec.states[0])
             ends = rec.ep_meta.get("subtask_ends") or subtask_ends(sim, rec.states)
-            demos.append((rec.states, rec.actions, list(ends)))
-        _CACHE[key] = _TaskState(sim, StateRenderer(sim.model, cfg.size), demos)
+            if len(ends) != len(spec.subtasks):
+                raise InputError(
+                    f"{spec.name}: demonstration {rec.name} never completes subtask "
+                    f"{spec.subtasks[len(ends)].name!r}; it cannot serve as an expert"
+                )
+            demos.append((rec.states, rec.actions, list(ends), seed))
+        renderer = StateRenderer(sim.model, cfg.size)
+        if not _CACHE:  # after mujoco's EGL module registered its own exit hook
+            atexit.register(_close_renderers)
+        _CACHE[key] = _TaskState(sim, renderer, demos)
     return _CACHE[key]
 
 
 def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
     """Source demonstrations for a task: scripted experts, or the user's HDF5 file."""
-    from rover.sim.demos import DemoRecord, read_demos, write_demos
+    from rover.sim.demos import DemoRecord, read_demos, read_env_args, write_demos
     from rover.sim.env import SimEnv
     from rover.sim.experts import run_expert
 
@@ -133,7 +142,14 @@ def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
         return path
     spec = get_task(task)
     if cfg.source_hdf5:
-        recs = read_demos(Path(cfg.source_hdf5), limit=cfg.demos)
+        src = Path(cfg.source_hdf5)
+        env_name = read_env_args(src).get("env_name")
+        if env_name != spec.env_name:
+            raise InputError(
+                f"--source-hdf5 {src}: demonstrations of {env_name!r}, but task {task} "
+                f"runs {spec.env_name!r}"
+            )
+        recs = read_demos(src, limit=cfg.demos)
         write_demos(path, spec.env_name, spec.env_kwargs, recs)
         return path
     sim = SimEnv(spec)
@@ -148,8 +164,9 @@ def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
                     name=f"demo_{len(recs)}",
                     states=demo.states,
                     actions=demo.actions,
-                    model_file=sim.env.sim.model.get_xml() if hasattr(
-                        sim.env.sim.model, "get_xml") else None,
+                    model_file=sim.env.sim.model.get_xml()
+                    if hasattr(sim.env.sim.model, "get_xml")
+                    else None,
                     ep_meta={"seed": seed, "subtask_ends": demo.subtask_ends, "task": task},
                 )
             )
@@ -165,8 +182,7 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
     """Generate and write one episode; returns its id."""
     from rover.sim.facts import detect_events, facts_for_states, qa_items
     from rover.sim.perturb import bounds_from_ends, execute_plan, plan_trajectory
-    from rover.sim.value import point_tracks, required_points
-    from rover.sim.value import progress_from_tracks
+    from rover.sim.value import point_tracks, progress_from_tracks, required_points
 
     spec = get_task(item.task)
     ts = _task_state(spec, cfg, out / "demos")
@@ -174,9 +190,9 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
     level = next(lv for lv in spec.levels if lv.level == item.level)
     rng = plan_seed(cfg.seed, item.task, item.index)
     d = int(rng.integers(len(ts.demos)))
-    states, actions, ends = ts.demos[d]
-    seed = int(_demo_seed(out, item.task, d))
-    sim.reset(seed)  # start positions (lift heights, goals) of this demo's scene
+    states, actions, ends, seed = ts.demos[d]
+    sim.reset(seed)  # places robosuite's visual-only markers as in the demo's scene
+    sim.begin(states[0])  # start positions (lift heights, goals) of this demo
     bounds = bounds_from_ends(ends, len(states))
     plan = plan_trajectory(len(states), bounds, level, rng)
     roll = execute_plan(sim, states, actions, plan, np.random.default_rng(rng.integers(2**63)))
@@ -228,12 +244,6 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
     )
     write_episode(out, episode)
     return episode.id
-
-
-def _demo_seed(out: Path, task: str, d: int) -> int:
-    from rover.sim.demos import read_demos
-
-    return int(read_demos(out / "demos" / f"{task}.hdf5")[d].ep_meta.get("seed", 0))
 
 
 def _subtasks(spec: TaskSpec, sub_idx: np.ndarray) -> list[Subtask]:

@@ -7,9 +7,7 @@ from rover.sim.tasks import composite, doors, pick, pick_place, stack
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 _REGISTRY: dict[str, TaskSpec] = {
-    t.name: t
-    for module in (pick, pick_place, stack, doors, composite)
-    for t in module.TASKS
+    t.name: t for module in (pick, pick_place, stack, doors, composite) for t in module.TASKS
 }
 
 __all__ = [
@@ -33,6 +31,4 @@ def get_task(name: str) -> TaskSpec:
     try:
         return _REGISTRY[name]
     except KeyError:
-        raise InputError(
-            f"unknown task {name!r}; valid tasks: {', '.join(task_names())}"
-        ) from None
+        raise InputError(f"unknown task {name!r}; valid tasks: {', '.join(task_names())}") from None

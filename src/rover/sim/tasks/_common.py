@@ -51,8 +51,10 @@ def named_levels(milestones: Sequence[Sequence[str]], names: Sequence[str]) -> l
 def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
     """App. B Table 5, pick-and-place group: seven levels."""
     return named_levels(
-        [[f"Approach the {obj}", f"Contact the {obj}"], [f"Keep grasp of the {obj}",
-          f"Approach placing the {obj} {target}"]],
+        [
+            [f"Approach the {obj}", f"Contact the {obj}"],
+            [f"Keep grasp of the {obj}", f"Approach placing the {obj} {target}"],
+        ],
         [
             f"Fail to approach the {obj}",
             f"Approach the {obj}",
@@ -68,12 +70,29 @@ def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
 def pick_place_qa(obj: str, target: str) -> list[QATemplate]:
     """App. C.3 pick-and-place questions for one object."""
     return [
-        QATemplate(id="did_contact", text=f"Did the robot contact the {obj}? If so, when?",
-                   event="contact", object=obj),
-        QATemplate(id="did_pick_up", text=f"Did the robot pick up the {obj}? If so, when?",
-                   event="pick_up", object=obj),
-        QATemplate(id="did_drop", text=f"Did the robot drop the {obj}? If so, when?",
-                   event="drop", object=obj),
-        QATemplate(id="did_place", text=f"Did the robot place the {obj} {target}? If so, when?",
-                   event="place", object=obj, target=target),
+        QATemplate(
+            id="did_contact",
+            text=f"Did the robot contact the {obj}? If so, when?",
+            event="contact",
+            object=obj,
+        ),
+        QATemplate(
+            id="did_pick_up",
+            text=f"Did the robot pick up the {obj}? If so, when?",
+            event="pick_up",
+            object=obj,
+        ),
+        QATemplate(
+            id="did_drop",
+            text=f"Did the robot drop the {obj}? If so, when?",
+            event="drop",
+            object=obj,
+        ),
+        QATemplate(
+            id="did_place",
+            text=f"Did the robot place the {obj} {target}? If so, when?",
+            event="place",
+            object=obj,
+            target=target,
+        ),
     ]

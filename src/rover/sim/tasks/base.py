@@ -89,6 +89,7 @@ class TaskSpec(BaseModel):
     expert: str  # scripted expert name in `rover.sim.experts`
     max_expert_steps: int = 400
     bins: dict[str, int] = Field(default_factory=dict)  # PickPlace: object -> bin index
+    clear_objects: list[str] = Field(default_factory=list)  # robosuite objects moved away
 
     def object_spec(self, name: str) -> ObjectSpec:
         for obj in self.objects:

@@ -31,7 +31,10 @@ def restock_task(items: tuple[str, ...] = ITEMS) -> TaskSpec:
         env_kwargs={"single_object_mode": 0},
         description=f"Restock the shelf: put {listing}.",
         group="composite",
-        objects=[ObjectSpec(name=o, body=BODY_OF[o]) for o in BIN_OF],
+        objects=[ObjectSpec(name=o, body=BODY_OF[o]) for o in items],
+        # the other PickPlace items are moved out of the scene (as robosuite's
+        # single-object mode does), so the two items are reachable without clutter
+        clear_objects=[o.capitalize() for o in BIN_OF if o not in items],
         goals={f"bin_{o}": GoalSpec(kind="bin", object=o) for o in items},
         bins={o: BIN_OF[o] for o in items},
         subtasks=subtasks,

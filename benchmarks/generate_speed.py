@@ -1,0 +1,117 @@
+"""Generator speed vs. its physics-only and render-only ceilings, measured in one run.
+
+Usage: python benchmarks/generate_speed.py [--tasks Lift,PickPlaceCan] [--episodes 4]
+       [--frames 30] [--views left,wrist] [--size 128]
+
+Per task, after a warm-up episode (the first episode per process pays for building the
+env, the renderer and numba/EGL start-up): the full pipeline (perturb + value + facts +
+render + MP4 write) in one process, the physics ceiling (control steps per second with
+no rendering) and the render ceiling (frames per second rendering saved states). CPU
+seconds include every thread of the process (llvmpipe renders with several).
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from rover.sim.generate import GenerateConfig, _task_state, generate_episode, make_demos, work_items
+from rover.sim.tasks import get_task
+
+
+def _timed(fn) -> tuple[float, float]:
+    w, c = time.perf_counter(), time.process_time()
+    fn()
+    return time.perf_counter() - w, time.process_time() - c
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--tasks", default="Lift,PickPlaceCan")
+    ap.add_argument("--episodes", type=int, default=4)
+    ap.add_argument("--frames", type=int, default=30)
+    ap.add_argument("--views", default="left,wrist")
+    ap.add_argument("--size", type=int, default=128)
+    args = ap.parse_args()
+    views = args.views.split(",")
+    table = Table(
+        title=f"rover generate: {args.frames} frames x {len(views)} views, "
+        f"{args.size} px, one process"
+    )
+    for col in (
+        "task",
+        "s/ep",
+        "CPU s/ep",
+        "ep/min",
+        "fps",
+        "steps/ep",
+        "phys steps/s",
+        "phys-only ep/min",
+        "render-only fps",
+    ):
+        table.add_column(col, justify="right")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp)
+        for name in args.tasks.split(","):
+            cfg = GenerateConfig(
+                tasks=[name],
+                per_level=args.episodes,
+                levels=["all"],
+                frames=args.frames,
+                views=views,
+                size=args.size,
+                demos=2,
+            )
+            make_demos(name, cfg, out / "demos")
+            items = work_items(cfg)
+            rng = np.random.default_rng(0)
+            picked = [items[i] for i in rng.choice(len(items), args.episodes + 1, replace=False)]
+            generate_episode(picked[0], cfg, out)  # warm-up
+            steps = 0
+            wall = cpu = 0.0
+            for it in picked[1:]:
+                w, c = _timed(lambda it=it, cfg=cfg: generate_episode(it, cfg, out))
+                wall, cpu = wall + w, cpu + c
+                from rover.io.dataset import read_episode
+
+                steps += read_episode(out, it.episode_id, load_frames=False).extra["steps"]
+            n = args.episodes
+            ts = _task_state(get_task(name), cfg, out / "demos")
+            sim = ts.sim
+            sim.reset(0)
+            act = np.zeros(len(sim.action_low))
+            w, _ = _timed(lambda sim=sim, act=act: [sim.step(act) for _ in range(100)])
+            phys = 100 / w
+            states = ts.demos[0][0][:: max(1, len(ts.demos[0][0]) // args.frames)][: args.frames]
+            w, _ = _timed(lambda ts=ts, states=states: ts.renderer.render(states, views))
+            rfps = len(states) * len(views) / w
+            per_ep = steps / n
+            table.add_row(
+                name,
+                f"{wall / n:.2f}",
+                f"{cpu / n:.2f}",
+                f"{60 * n / wall:.1f}",
+                f"{n * args.frames * len(views) / wall:.0f}",
+                f"{per_ep:.0f}",
+                f"{phys:.0f}",
+                f"{60 * phys / per_ep:.0f}",
+                f"{rfps:.0f}",
+            )
+    Console().print(table)
+    Console().print(
+        "s/ep, CPU s/ep, ep/min, fps: full pipeline (wall, CPU of all threads, episodes per "
+        "minute, rendered frames per second); steps/ep: recorded control steps per episode. "
+        "physics-only ep/min: every recorded step simulated, nothing rendered (an upper "
+        "bound: expert segments are restored states, not simulated); render-only fps: "
+        "saved states rendered, no simulation."
+    )
+
+
+if __name__ == "__main__":
+    main()
