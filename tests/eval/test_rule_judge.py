@@ -185,3 +185,27 @@ def test_claim_extraction_and_names() -> None:
     assert names_match("soda can", "can") and names_match("bin 2", "bin_2")
     assert not names_match("bin 1", "bin 2")
     assert judge_description("The gripper is open.", None).verdict == "inconclusive"
+
+
+def test_every_oracle_sentence_on_the_bundled_dataset_is_checked() -> None:
+    """Real simulator facts: each oracle sentence is read as a claim, each flip is found."""
+    oracle = pytest.importorskip("rover.vlm.oracle")
+    from rover.io.dataset import load_dataset
+    from rover.sim import bundled_dataset_path
+
+    root = bundled_dataset_path()
+    if not (root / "dataset.json").exists():
+        pytest.skip("bundled dataset not built")
+    flips = found = frames = 0
+    for ep in load_dataset(root, load_frames=False):
+        for i, facts in enumerate(ep.truth.facts):
+            clean = oracle.describe(facts, 0.0)
+            j = judge_description(clean, facts)
+            assert len(j.true_claims) == len(clean.split(". ")) and not j.false_claims, clean
+            noisy = oracle.describe(facts, 0.3, np.random.default_rng(i))
+            a, b = clean.split(". "), noisy.split(". ")
+            if len(a) == len(b):
+                flips += sum(x != y for x, y in zip(a, b, strict=True))
+                found += len(judge_description(noisy, facts).false_claims)
+            frames += 1
+    assert frames > 0 and flips > 0 and found == flips

@@ -95,6 +95,13 @@ def test_sweeps_make_one_variant_per_combination(tmp_path: Path, make_dataset) -
     assert trace["frame_indices"] == [0, 2, 4, 7, 9, 11]  # Episode.subsample(6) of 12
     by_view = {a["group"] for a in m["aggregates"] if a["by"] == "view"}
     assert by_view == {"left", "wrist"}
+    summary = (out / "summary.md").read_text()
+    for title in (
+        "App. H: by frames per video",
+        "App. I: by camera view",
+        "App. M: by sliding-window size",
+    ):
+        assert title in summary
     frames = {(r["variant"], r["n_frames"]) for r in m["per_trace"]}
     assert all(n == (6 if "__f=6__" in v else 12) for v, n in frames)
 
@@ -192,6 +199,7 @@ def _main(monkeypatch, capsys, *args: str) -> tuple[int, str]:
         (["--dataset", "{ds}", "--window", "1"], "--window: 1 is below the minimum"),
         (["--dataset", "{ds}", "--views", "top"], "no view 'top'"),
         (["--dataset", "{ds}", "--backend", "nonsense:x"], "unknown VLM spec"),
+        (["--dataset", "{ds}", "--judge", "oracle"], "cannot judge or answer questions"),
         (["--dataset", "{ds}", "--source", "{ds}"], "either --dataset or --source"),
         ([], "--dataset DIR or --source SPEC"),
         (["--dataset", "{ds}", "--out", "{ds}"], "not empty; add --resume"),
@@ -247,3 +255,43 @@ def test_command_line_secrets_are_scrubbed() -> None:
     for secret in ("abc123secret", "xyz", "pw@", "s3cr3t", "sk-abcdefghijklmn"):
         assert secret not in out
     assert "MYKEY" in out  # the name of a variable is not a secret
+
+
+def test_resume_after_judge_failures_needs_no_video(tmp_path: Path, make_dataset) -> None:
+    """Traces done, LLM judge down: a resume retries judging from saved ground truth alone."""
+    ds = make_dataset(tmp_path / "ds", n=2, frames=6)
+    out = tmp_path / "run"
+    dead = "openai:judge@http://127.0.0.1:9/v1"  # nothing listens on the discard port
+    args = [
+        "--dataset",
+        str(ds),
+        "--methods",
+        "gvl",
+        "--judge",
+        dead,
+        "--answerer",
+        "none",
+        "--no-cache",
+        "--max-retries",
+        "0",
+        "--timeout",
+        "5",
+        "--out",
+        str(out),
+    ]
+    assert _eval(*args).exit_code == 0
+    errors = [json.loads(x) for x in (out / "errors.jsonl").read_text().splitlines()]
+    assert [e["stage"] for e in errors] == ["judge", "judge"]
+    traces = {p: p.read_bytes() for p in (out / "traces").rglob("*.json")}
+    for video in ds.rglob("*.mp4"):
+        video.unlink()  # a resume with only judging left must not need pixels
+    assert _eval(*args, "--resume").exit_code == 0
+    errors = [json.loads(x) for x in (out / "errors.jsonl").read_text().splitlines()]
+    assert [e["stage"] for e in errors] == ["judge", "judge"]  # not "load"
+    assert {p: p.read_bytes() for p in (out / "traces").rglob("*.json")} == traces
+    m = _metrics(out)
+    assert m["counts"]["traces"] == 2
+    assert all(
+        r.get("error_rate") is None and r["stage_error"].startswith("judge: ")
+        for r in m["per_trace"]
+    )

@@ -32,14 +32,18 @@ def eval_command(
         typer.Option(
             "--source",
             help="Instead of --dataset: source spec(s), comma-separated "
-            "(lerobot:PATH, rlds:PATH, hdf5:PATH, a video folder...)",
+            "(lerobot:PATH, rlds:PATH, hdf5:PATH, a video file, a dataset dir...)",
         ),
     ] = None,
     methods: Annotated[
         str, typer.Option("--methods", help="Comma-separated method names.")
     ] = "rover,gvl,temporal-concat,local-concat",
     backend: Annotated[
-        str, typer.Option("--backend", help="VLM spec(s), comma-separated: " + vo.VLM_HELP)
+        str,
+        typer.Option(
+            "--backend",
+            help="VLM spec(s), comma-separated (" + vo.VLM_HELP.removeprefix("VLM spec: ") + ")",
+        ),
     ] = "oracle",
     judge: Annotated[
         str, typer.Option("--judge", help="Task 2 judge: 'rule', a VLM spec, or 'none'.")

@@ -63,6 +63,23 @@ TABLE_OF = {
 }
 
 
+# every scored row carries these keys (None when that part of the evaluation did not run)
+_SCORE_KEYS = (
+    "pearson",
+    "pearson_constant",
+    "l2",
+    "voc",
+    "voc_constant",
+    "frame_corr",
+    "error_rate",
+    "success_rate",
+    "n_judged",
+    "qa_accuracy",
+    "qa_n",
+    "stage_error",
+)
+
+
 def _load(path, model):
     return model.model_validate_json(path.read_text()) if path.exists() else None
 
@@ -114,6 +131,7 @@ def compute_metrics(rundir: RunDir, config: dict[str, Any]) -> dict[str, Any]:
                 "task": ep.task,
                 "error": None,
                 "progress_source": ep.truth.progress_source if ep.truth else None,
+                **dict.fromkeys(_SCORE_KEYS),
                 **cost_row(trace),
             }
             if ep.truth is not None:
@@ -136,6 +154,9 @@ def compute_metrics(rundir: RunDir, config: dict[str, Any]) -> dict[str, Any]:
                 answers.setdefault(v.id, []).extend((row, a) for a in qa.answers)
             for k, flag in video_errors(trace, ep, judg).items():
                 row[f"err_{k}"] = flag
+            if (eid, v.id) in errors:  # the trace is done but a later stage failed
+                e = errors[(eid, v.id)]
+                row["stage_error"] = f"{e.get('stage')}: {e.get('error')}"
             rows.append(row)
     multi_dataset = len({r.get("dataset") for r in rows}) > 1
     out = {

@@ -40,6 +40,7 @@ from rover.vlm.config import BackendConfig
 from rover.vlm.types import EncodedImage, ImageEncoding
 
 OFF = ("none", "off", "skip")
+PRE_ENCODE_BUDGET = 3072  # images; below the EncodedImage memo's capacity (4096)
 
 
 class EvalOptions(BaseModel):
@@ -172,6 +173,11 @@ class Runner:
     def _aux(self, spec: str) -> Any:
         if spec.lower() in OFF or spec.lower() == "rule":
             return None
+        if spec.strip().lower() == "oracle":
+            raise InputError(
+                f"{spec!r} cannot judge or answer questions (it only answers method prompts); "
+                "use 'rule' or an LLM spec for --judge / --answerer"
+            )
         if spec in self.vlms or spec in self._given:
             return self.vlms.get(spec) or self._given[spec]
         config = self.opts.backend_config.model_copy(update={"flip_prob": 0.0, "jitter": 0.0})
@@ -226,15 +232,24 @@ class Runner:
         Methods encode each frame they send through `EncodedImage.from_any`, which memoises
         by pixels and settings; encoding here first means the loop only finds them ready.
         """
+        saved = self.rundir.episode_path(ref.id)
+        if saved.exists() and all(self.rundir.done("trace", ref.id, v.id) for v in pending):
+            # only judging / QA is left: ground truth is enough, no need to decode video
+            meta = Episode.model_validate_json(saved.read_text())
+            return meta, meta
         meta, loaded = load_for_variants(ref, pending)
         encodings: dict[str, ImageEncoding] = {}
         for v in pending:
             enc = getattr(self.vlms[v.backend], "image_encoding", None) or ImageEncoding()
             encodings[enc.model_dump_json()] = enc
-        for arr in loaded.views.values():
-            for enc in encodings.values():
-                for frame in arr:
-                    EncodedImage.from_any(frame, enc)
+        total = sum(len(arr) for arr in loaded.views.values()) * len(encodings)
+        # the memo holds a few thousand images: pre-encode only what fits for every episode
+        # in flight, else later episodes would evict earlier ones' frames before use
+        if total <= PRE_ENCODE_BUDGET // max(1, self.opts.concurrency):
+            for arr in loaded.views.values():
+                for enc in encodings.values():
+                    for frame in arr:
+                        EncodedImage.from_any(frame, enc)
         return meta, loaded
 
     async def _fail(self, ref: EpisodeRef, v: Variant, stage: str, exc: BaseException) -> None:

@@ -21,6 +21,13 @@ MAIN_COLUMNS = [
     ("Tokens/video", "agg", "total_tokens", 0),
     ("Calls/video", "agg", "calls", 1),
 ]
+METRIC_NAMES = {
+    "pearson": "Pearson r",
+    "l2": "L2 distance",
+    "error_rate": "error rate",
+    "success_rate": "success rate",
+    "voc": "VOC",
+}
 LEVEL_NAMES = {
     "task_group": "task group",
     "level": "level",
@@ -112,6 +119,47 @@ def pivot(
     return headers, rows
 
 
+SWEEPS = [  # (variant field, title, metrics)
+    ("frames", "App. H: by frames per video", ("pearson", "error_rate")),
+    ("view", "App. I: by camera view", ("pearson", "error_rate")),
+    ("backend", "App. J: by backbone VLM", ("pearson", "l2", "error_rate", "success_rate")),
+    ("window", "App. M: by sliding-window size", ("pearson", "error_rate")),
+]
+_SHORT = {"backend": "b", "frames": "f", "window": "w", "view": "v"}
+
+
+def sweep_pivot(
+    metrics: dict[str, Any], dim: str, metric: str, digits: int = 2
+) -> tuple[list[str], list[list[str]]] | None:
+    """Rows = values of one swept setting, columns = the other variant settings."""
+    variants = metrics.get("variants", [])
+    values = {v[dim] for v in variants if v[dim] is not None}
+    if len(values) < 2:
+        return None
+    others = [
+        k
+        for k in _SHORT
+        if k != dim and len({v[k] for v in variants if k != "window" or v[k] is not None}) > 1
+    ]
+
+    def column(v: dict[str, Any]) -> str:
+        extra = [f"{_SHORT[k]}={v[k]}" for k in others if v[k] is not None]
+        return v["method"] + (f" [{', '.join(extra)}]" if extra else "")
+
+    idx = _agg_index(metrics)
+    cols = list(dict.fromkeys(column(v) for v in variants if v[dim] is not None))
+    cell: dict[tuple[str, Any], str] = {}
+    for v in variants:
+        a = idx.get((v["id"], metric, "all", "all"))
+        if v[dim] is not None and a is not None and a["mean"] is not None:
+            cell[(column(v), v[dim])] = _fmt(a["mean"], a["se"], digits) + f" (n={a['n']})"
+    rows = [
+        [str(val)] + [cell.get((c, val), "–") for c in cols]
+        for val in sorted(values, key=_group_key)
+    ]
+    return [LEVEL_NAMES.get(dim, dim)] + cols, rows
+
+
 def _group_key(g: Any) -> tuple:
     s = str(g)
     head = s.split("-")[0].rstrip("%")
@@ -172,6 +220,16 @@ def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
         t = pivot(metrics, metric, by, digits)
         if t is not None and (by != "dataset" or len(t[1]) > 0):
             out += [f"## {title}", "", markdown_table(*t), ""]
+    for dim, title, names in SWEEPS:
+        for metric in names:
+            t = sweep_pivot(metrics, dim, metric, 1 if metric == "l2" else 2)
+            if t is not None:
+                out += [
+                    f"## {title}: {METRIC_NAMES.get(metric, metric)}",
+                    "",
+                    markdown_table(*t),
+                    "",
+                ]
     out += _cost_section(metrics) + _error_section(metrics) + _counts_section(metrics)
     return "\n".join(out).rstrip() + "\n"
 
@@ -242,7 +300,11 @@ def _counts_section(metrics: dict[str, Any]) -> list[str]:
         f"- parse failures in traces: {c.get('parse_failures', 0)}",
         "",
     ]
-    failed = [r for r in metrics.get("per_trace", []) if r.get("error")]
+    failed = [
+        {**r, "error": r.get("error") or r.get("stage_error")}
+        for r in metrics.get("per_trace", [])
+        if r.get("error") or r.get("stage_error")
+    ]
     if failed:
         out += ["### Failed units", ""]
         for r in failed[:30]:

@@ -25,11 +25,16 @@ LIFT_HEIGHT = 0.04  # m above its start height for an object to count as lifted
 
 def _import_robosuite():
     os.environ.setdefault("MUJOCO_GL", "egl")
+    # robosuite logs set-up advice (private macro file, optional robot packages) at
+    # import; none of it applies here, so keep it off the user's console
+    logging.disable(logging.WARNING)
     try:
         import robosuite
         from robosuite.controllers import load_composite_controller_config
     except ImportError as exc:  # pragma: no cover - depends on the install
         raise MissingExtraError("robosuite", "sim", "simulated benchmark generation") from exc
+    finally:
+        logging.disable(logging.NOTSET)
     for name in ("robosuite", "robosuite_logs"):
         logging.getLogger(name).setLevel(logging.ERROR)
     return robosuite, load_composite_controller_config
@@ -50,6 +55,9 @@ def make_robosuite_env(env_name: str, env_kwargs: dict | None = None):
         horizon=100_000,
         ignore_done=True,
         reward_shaping=False,
+        # the model itself is randomised at construction (Lift's and Stack's cube sizes):
+        # a fixed seed gives every process the same model, so saved states fit everywhere
+        seed=0,
     )
     kwargs.update(env_kwargs or {})
     return suite.make(env_name, **kwargs)

@@ -151,14 +151,27 @@ def clear_yaw(sim: SimEnv, obj: str) -> float:
 def pick_phases(
     sim: SimEnv, obj: str, period: float | None, grasp_dz: float = 0.0, point: str | None = None
 ) -> list[Phase]:
-    """Approach from above, descend, close, lift."""
+    """Approach from above, descend, close, lift.
+
+    With `point` (a handle site), the grasp sits `_OUTWARD[obj]` further out along the
+    handle, away from the object's centre (keeps the palm clear of a peg).
+    """
     where = point or obj
+    out = _OUTWARD.get(obj, 0.0)
+
+    def grip_point() -> np.ndarray:
+        p = sim.point(where)
+        if out:
+            d = p - sim.point(obj)
+            d[2] = 0.0
+            p = p + out * d / max(float(np.linalg.norm(d)), 1e-6)
+        return p
 
     def above() -> np.ndarray:
-        return sim.point(where) + np.array([0, 0, 0.10 + grasp_dz])
+        return grip_point() + np.array([0, 0, 0.10 + grasp_dz])
 
     def at() -> np.ndarray:
-        return sim.point(where) + np.array([0, 0, grasp_dz])
+        return grip_point() + np.array([0, 0, grasp_dz])
 
     turn = _YAW_OFFSET.get(obj, 0.0)
     if period:
@@ -270,6 +283,7 @@ _PERIOD = {
 # tall objects: grasp this far above their centre so the palm clears their top (m)
 _GRASP_DZ = {"milk": 0.045, "cereal": 0.035}
 _YAW_OFFSET = {"cereal": np.pi / 2}
+_OUTWARD = {"square nut": 0.015}
 
 
 def _pick_retry(sim: SimEnv, obj: str, period, dz: float = 0.0, point=None) -> Retry:
@@ -297,6 +311,7 @@ def _nut_script(sim: SimEnv) -> list[Phase | Retry]:
     grasp, move = sim.spec.subtasks
     nut = grasp.object
     phases = [_pick_retry(sim, nut, np.pi, point=f"{nut}:handle")]
+    hand0 = sim.data.site_xmat[sim._eef_site].reshape(3, 3).copy()  # hand at reset
     table_z = float(sim.env.table_offset[2])
 
     def held_offset() -> np.ndarray:
@@ -317,10 +332,24 @@ def _nut_script(sim: SimEnv) -> list[Phase | Retry]:
             rest[0] = sim.point("eef")
         return rest[0]
 
+    turn: list[float] = []
+
+    def carry_yaw() -> float:
+        # turn the nut by a multiple of 90 degrees (the peg is square) so its handle, and
+        # the hand holding it, point back toward the robot: a far peg stays reachable
+        if not turn:
+            d = (sim.point(f"{nut}:handle") - sim.point(nut))[:2]
+            now = float(np.arctan2(d[1], d[0]))
+            best = min((-1, 0, 1), key=lambda k: abs(_wrap(now + k * np.pi / 2 - np.pi, 2 * np.pi)))
+            cur = sim.data.site_xmat[sim._eef_site].reshape(3, 3)
+            turn.append(_yaw_of(cur @ hand0.T) + best * np.pi / 2)
+        return turn[0]
+
     return phases + [
-        Phase(over, CLOSE, tol=0.01, steps=120, gain=0.6),
-        Phase(down, CLOSE, tol=0.01, steps=60, gain=0.6),
-        Phase(let_go, OPEN, tol=None, steps=8),
+        Phase(over, CLOSE, tol=0.006, steps=120, gain=1.2, yaw=carry_yaw),
+        Phase(over, CLOSE, tol=None, steps=10, gain=1.2),  # let the hanging nut settle
+        Phase(down, CLOSE, tol=0.01, steps=60, gain=0.4),
+        Phase(let_go, OPEN, tol=None, steps=15),
         Phase(lambda: let_go() + np.array([0, 0, 0.08]), OPEN, tol=0.02, steps=20),
     ]
 

@@ -12,6 +12,7 @@ seeded by (seed, task, index), so a rerun or a resumed run reproduces the same e
 from __future__ import annotations
 
 import atexit
+import logging
 import multiprocessing as mp
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -28,6 +29,7 @@ from rover.sim.tasks import get_task
 from rover.sim.tasks.base import TaskSpec
 
 MAX_FRAMES = 240
+_log = logging.getLogger(__name__)
 
 
 class GenerateConfig(BaseModel):
@@ -88,46 +90,55 @@ def work_items(cfg: GenerateConfig) -> list[WorkItem]:
 class _TaskState:
     sim: object
     renderer: object | None
-    demos: list = field(default_factory=list)  # (states, actions, ends)
+    demos: list = field(default_factory=list)  # (states, actions, subtask ends, seed)
     tracks: dict = field(default_factory=dict)
 
 
-_CACHE: dict[tuple[str, int], _TaskState] = {}
+_SIMS: dict[str, object] = {}  # task -> SimEnv (building one takes about a second)
+_RENDERERS: dict[tuple[str, int], object] = {}
+_CACHE: dict[tuple[str, int, str], _TaskState] = {}
 
 
 def _close_renderers() -> None:
     # free EGL contexts before interpreter teardown (else mujoco prints EGL errors)
-    for ts in _CACHE.values():
-        if ts.renderer is not None:
-            ts.renderer.close()
+    for r in _RENDERERS.values():
+        r.close()
+    _RENDERERS.clear()
     _CACHE.clear()
 
 
 def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskState:
+    """This process's simulator, renderer and loaded demos for a task (built once)."""
     from rover.sim.demos import read_demos
     from rover.sim.env import SimEnv
     from rover.sim.experts import subtask_ends
     from rover.sim.render import StateRenderer
 
-    key = (spec.name, cfg.size)
-    if key not in _CACHE:
-        sim = SimEnv(spec)
-        demos = []
-        for rec in read_demos(demo_dir / f"{spec.name}.hdf5"):
-            seed = int(rec.ep_meta.get("seed", 0))
-            sim.reset(seed)
-            sim.begin(rec.states[0])
-            ends = rec.ep_meta.get("subtask_ends") or subtask_ends(sim, rec.states)
-            if len(ends) != len(spec.subtasks):
-                raise InputError(
-                    f"{spec.name}: demonstration {rec.name} never completes subtask "
-                    f"{spec.subtasks[len(ends)].name!r}; it cannot serve as an expert"
-                )
-            demos.append((rec.states, rec.actions, list(ends), seed))
-        renderer = StateRenderer(sim.model, cfg.size)
-        if not _CACHE:  # after mujoco's EGL module registered its own exit hook
+    path = demo_dir / f"{spec.name}.hdf5"
+    key = (spec.name, cfg.size, str(path.resolve()))
+    if key in _CACHE:
+        return _CACHE[key]
+    if spec.name not in _SIMS:
+        _SIMS[spec.name] = SimEnv(spec)
+    sim = _SIMS[spec.name]
+    if (spec.name, cfg.size) not in _RENDERERS:
+        first = not _RENDERERS
+        _RENDERERS[(spec.name, cfg.size)] = StateRenderer(sim.model, cfg.size)
+        if first:  # registered after mujoco's EGL exit hook (made with the first context)
             atexit.register(_close_renderers)
-        _CACHE[key] = _TaskState(sim, renderer, demos)
+    demos = []
+    for rec in read_demos(path):
+        seed = int(rec.ep_meta.get("seed", 0))
+        sim.reset(seed)
+        sim.begin(rec.states[0])
+        ends = rec.ep_meta.get("subtask_ends") or subtask_ends(sim, rec.states)
+        if len(ends) != len(spec.subtasks):
+            raise InputError(
+                f"{spec.name}: demonstration {rec.name} never completes subtask "
+                f"{spec.subtasks[len(ends)].name!r}; it cannot serve as an expert"
+            )
+        demos.append((rec.states, rec.actions, list(ends), seed))
+    _CACHE[key] = _TaskState(sim, _RENDERERS[(spec.name, cfg.size)], demos)
     return _CACHE[key]
 
 
@@ -182,6 +193,7 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
     """Generate and write one episode; returns its id."""
     from rover.sim.facts import detect_events, facts_for_states, qa_items
     from rover.sim.perturb import bounds_from_ends, execute_plan, plan_trajectory
+    from rover.sim.validate import validate_episode
     from rover.sim.value import point_tracks, progress_from_tracks, required_points
 
     spec = get_task(item.task)
@@ -242,6 +254,10 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
         },
         views=frames,
     )
+    problems = validate_episode(episode, max_level=max(lv.level for lv in spec.levels))
+    if problems:  # kept, but flagged: the dataset report and tests look for these
+        episode.extra["problems"] = problems
+        _log.warning("%s: %s", episode.id, "; ".join(problems))
     write_episode(out, episode)
     return episode.id
 
