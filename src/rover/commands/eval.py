@@ -25,7 +25,11 @@ def register(app: typer.Typer) -> None:
 def eval_command(
     out: Annotated[Path, typer.Option("--out", help="Run directory to write (RUN_DIR).")],
     dataset: Annotated[
-        Path | None, typer.Option("--dataset", help="A rover dataset directory.")
+        Path | None,
+        typer.Option(
+            "--dataset",
+            help="A rover dataset directory ('bundled': the small one shipped with rover).",
+        ),
     ] = None,
     source: Annotated[
         str | None,
@@ -142,6 +146,10 @@ def eval_command(
         raise InputError("give either --dataset or --source, not both")
     if dataset is None and source is None:
         raise InputError("give the data to evaluate: --dataset DIR or --source SPEC")
+    if dataset is not None and str(dataset) == "bundled" and not dataset.exists():
+        from rover.sim import bundled_dataset_path
+
+        dataset = bundled_dataset_path()
     opts = EvalOptions(
         dataset=dataset,
         sources=parse_name_list(source, "--source") if source else [],
@@ -186,7 +194,7 @@ def eval_command(
     runner = prepare_run(opts, on_update)
     with progress:
         state, metrics = asyncio.run(finish_run(runner))
-    _print_main_table(metrics)
+    _print_main_table(metrics, oracle="oracle" in opts.backends)
     out_console = Console(highlight=False)
     out_console.print(f"run directory: {out}  (metrics.json, summary.md)")
     if state.errors:
@@ -200,11 +208,14 @@ def eval_command(
         raise typer.Exit(1)
 
 
-def _print_main_table(metrics: dict) -> None:
+def _print_main_table(metrics: dict, oracle: bool = False) -> None:
     from rover.eval.summary import main_rows
 
     headers, rows = main_rows(metrics, compact=True)
-    table = Table(title="rover eval: mean over videos (± SE in summary.md)")
+    title = "rover eval: mean over videos (± SE in summary.md)"
+    if oracle:
+        title += "\nORACLE OUTPUT: oracle rows answer from ground truth, not a VLM"
+    table = Table(title=title)
     for h in headers:
         table.add_column(h, overflow="fold", no_wrap=h == "Method")
     for r in rows:

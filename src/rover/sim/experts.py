@@ -296,8 +296,11 @@ def _pick_retry(sim: SimEnv, obj: str, period, dz: float = 0.0, point=None) -> R
 def _pick_place_script(sim: SimEnv) -> list[Phase | Retry]:
     phases: list[Phase | Retry] = []
     subs = sim.spec.subtasks
-    for grasp, move in zip(subs[0::2], subs[1::2], strict=True):
+    home = sim.point("eef")
+    for k, (grasp, move) in enumerate(zip(subs[0::2], subs[1::2], strict=True)):
         obj = grasp.object
+        if k:  # back to the start pose first: from the far bin the arm cannot turn well
+            phases.append(Phase(lambda: home, OPEN, tol=0.03, steps=60, yaw=lambda: 0.0))
         phases.append(_pick_retry(sim, obj, _PERIOD.get(obj), _GRASP_DZ.get(obj, 0.0)))
         into_bin = move.end_signal.startswith("placed")
         carry = sim.point(move.goal)[2] + 0.20

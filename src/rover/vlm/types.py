@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+from collections import OrderedDict
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Protocol, runtime_checkable
 
@@ -30,7 +31,9 @@ class ImageEncoding(BaseModel):
     max_side: int | None = None  # downscale so the long side is at most this (never upscale)
 
 
-_ENCODED: dict[tuple[str, str], EncodedImage] = {}
+# LRU memo of encoded images: a long run keeps its recent frames hot instead of
+# dropping everything when the memo fills up.
+_ENCODED: OrderedDict[tuple[str, str], EncodedImage] = OrderedDict()
 _ENCODED_MAX = 4096
 
 
@@ -70,6 +73,7 @@ class EncodedImage(BaseModel):
         memo_key = (pixel_key, enc.model_dump_json())
         hit = _ENCODED.get(memo_key)
         if hit is not None:
+            _ENCODED.move_to_end(memo_key)
             return hit
         pil = Image.fromarray(arr) if arr is not None else image
         if pil.mode not in ("RGB", "L"):
@@ -90,9 +94,9 @@ class EncodedImage(BaseModel):
             height=pil.height,
             sha256=hashlib.sha256(data).hexdigest(),
         )
-        if len(_ENCODED) >= _ENCODED_MAX:
-            _ENCODED.clear()
         _ENCODED[memo_key] = out
+        while len(_ENCODED) > _ENCODED_MAX:
+            _ENCODED.popitem(last=False)
         return out
 
 
