@@ -103,7 +103,7 @@ def main() -> None:
                 f"{60 * phys / per_ep:.0f}",
                 f"{rfps:.0f}",
             )
-    Console().print(table)
+    Console(width=150).print(table)
     Console().print(
         "s/ep, CPU s/ep, ep/min, fps: full pipeline (wall, CPU of all threads, episodes per "
         "minute, rendered frames per second); steps/ep: recorded control steps per episode. "

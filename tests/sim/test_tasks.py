@@ -9,9 +9,6 @@ import pytest
 from rover.errors import InputError
 from rover.sim.tasks import get_task, task_names
 
-# tasks whose scripted expert is not yet reliable (see docs/generate.md)
-UNRELIABLE = {"PickPlaceCereal", "NutAssemblySquare", "NutAssemblyRound"}
-
 
 def test_registry_names_and_unknown_task():
     names = task_names()

@@ -61,7 +61,12 @@ def _inside(sim: SimEnv, obj: str) -> str | None:
         return None
     if hasattr(sim.env, "not_in_bin"):  # robosuite PickPlace: the four target compartments
         idx = sim.in_bin(obj)
-        return None if idx is None else f"bin {idx + 1}"
+        if idx is not None:
+            return f"bin {idx + 1}"
+        pos, src, half = sim.point(obj), sim.env.bin1_pos, np.asarray(sim.env.bin_size) / 2
+        if np.all(np.abs(pos[:2] - src[:2]) < half[:2]) and pos[2] < src[2] + 0.1:
+            return "start bin"  # the bin all items start in
+        return None
     if "peg" in sim.spec.goals and sim.on_peg(obj):
         return "peg"
     return None
@@ -69,13 +74,13 @@ def _inside(sim: SimEnv, obj: str) -> str | None:
 
 def _on(sim: SimEnv, obj: str, lifted: bool, held: bool) -> str | None:
     spec = sim.spec
-    if not spec.object_spec(obj).graspable or lifted or held:
+    if not spec.object_spec(obj).graspable or lifted or held or _inside(sim, obj):
         return None
     for other in spec.objects:
         if other.name != obj and other.graspable and sim.on_top(obj, other.name):
             return other.name
     start = sim.start_positions.get(obj)
-    if start is not None and abs(sim.point(obj)[2] - start[2]) < 0.01:
+    if start is not None and abs(sim.point(obj)[2] - start[2]) < 0.02:
         return "table"
     return None
 

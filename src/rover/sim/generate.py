@@ -107,10 +107,18 @@ def _close_renderers() -> None:
     _CACHE.clear()
 
 
+def _sim_for(spec: TaskSpec):
+    """This process's SimEnv for a task (building one takes about a second)."""
+    from rover.sim.env import SimEnv
+
+    if spec.name not in _SIMS:
+        _SIMS[spec.name] = SimEnv(spec)
+    return _SIMS[spec.name]
+
+
 def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskState:
     """This process's simulator, renderer and loaded demos for a task (built once)."""
     from rover.sim.demos import read_demos
-    from rover.sim.env import SimEnv
     from rover.sim.experts import subtask_ends
     from rover.sim.render import StateRenderer
 
@@ -118,9 +126,7 @@ def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskSta
     key = (spec.name, cfg.size, str(path.resolve()))
     if key in _CACHE:
         return _CACHE[key]
-    if spec.name not in _SIMS:
-        _SIMS[spec.name] = SimEnv(spec)
-    sim = _SIMS[spec.name]
+    sim = _sim_for(spec)
     if (spec.name, cfg.size) not in _RENDERERS:
         first = not _RENDERERS
         _RENDERERS[(spec.name, cfg.size)] = StateRenderer(sim.model, cfg.size)
@@ -145,7 +151,6 @@ def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskSta
 def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
     """Source demonstrations for a task: scripted experts, or the user's HDF5 file."""
     from rover.sim.demos import DemoRecord, read_demos, read_env_args, write_demos
-    from rover.sim.env import SimEnv
     from rover.sim.experts import run_expert
 
     path = demo_dir / f"{task}.hdf5"
@@ -163,7 +168,7 @@ def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
         recs = read_demos(src, limit=cfg.demos)
         write_demos(path, spec.env_name, spec.env_kwargs, recs)
         return path
-    sim = SimEnv(spec)
+    sim = _sim_for(spec)
     recs = []
     seed = cfg.seed * 100_003 + 1
     tries = 0
@@ -175,9 +180,7 @@ def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
                     name=f"demo_{len(recs)}",
                     states=demo.states,
                     actions=demo.actions,
-                    model_file=sim.env.sim.model.get_xml()
-                    if hasattr(sim.env.sim.model, "get_xml")
-                    else None,
+                    model_file=sim.env.sim.model.get_xml(),
                     ep_meta={"seed": seed, "subtask_ends": demo.subtask_ends, "task": task},
                 )
             )

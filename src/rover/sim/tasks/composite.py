@@ -7,7 +7,7 @@ from rover.sim.tasks._common import grasp_subtask, move_subtask, pick_place_qa
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
 from rover.sim.tasks.pick_place import BIN_OF, BODY_OF, bin_name
 
-ITEMS = ("can", "milk")
+ITEMS = ("milk", "can")  # the far bin (the can's) last: no long reach back from it
 
 
 def restock_task(items: tuple[str, ...] = ITEMS) -> TaskSpec:
