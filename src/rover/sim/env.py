@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 
 from rover.errors import InputError, MissingExtraError
+from rover.sim import articulation
 from rover.sim.interp import interpolate_state
 from rover.sim.tasks.base import TaskSpec
 
@@ -43,6 +44,8 @@ def _import_robosuite():
 def make_robosuite_env(env_name: str, env_kwargs: dict | None = None):
     """Build a camera-less Panda + OSC_POSE robosuite environment (fast to step)."""
     suite, load_cfg = _import_robosuite()
+    if env_name.startswith("Rover"):  # rover's own fixtures register on import
+        import rover.sim.fixtures  # noqa: F401
     controller = load_cfg(controller="BASIC", robot="Panda")
     kwargs = dict(
         robots="Panda",
@@ -206,6 +209,8 @@ class SimEnv:
             return self.start_positions[g.object] + off
         if g.kind == "door_open":
             return self._door_handle_at(g.angle)
+        if g.kind == "fixture":
+            return articulation.goal(self, g)
         raise ValueError(f"unknown goal kind {g.kind}")
 
     def _door_handle_at(self, angle: float) -> np.ndarray:
@@ -282,6 +287,9 @@ class SimEnv:
             return self.hinge_angle() > self.spec.goals["door_open"].angle * 0.9
         if kind == "on_peg":
             return self.on_peg(obj) and not self.grasped(obj)
+        found = articulation.predicate(self, kind, obj)
+        if found is not None:
+            return found
         raise ValueError(f"unknown end signal {signal!r}")
 
     def on_top(self, obj: str, below: str) -> bool:

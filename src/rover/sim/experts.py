@@ -16,6 +16,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from rover.sim.env import SimEnv
+from rover.sim.experts_articulated import SCRIPTS as ARTICULATED_SCRIPTS
 from rover.sim.motions import (
     CLOSE,
     GRASP_DZ,
@@ -32,6 +33,7 @@ from rover.sim.motions import (
 POS_SCALE = 0.05  # m per unit action (robosuite OSC_POSE output_max)
 ROT_SCALE = 0.5  # rad per unit action
 ROT_TOL = 0.08  # rad: a waypoint counts as reached only once the hand is turned too
+MAX_WRIST_YAW = 1.6  # rad from the start pose the scripts may turn the hand about z
 
 
 @dataclass
@@ -130,6 +132,7 @@ def _nut_script(sim: SimEnv) -> list[Phase | Retry]:
         return rest[0]
 
     turn: list[float] = []
+    square = nut.startswith("square")
 
     def carry_yaw() -> float:
         # turn the nut by a multiple of 90 degrees (the peg is square) so its handle, and
@@ -137,11 +140,16 @@ def _nut_script(sim: SimEnv) -> list[Phase | Retry]:
         if not turn:
             d = (sim.point(f"{nut}:handle") - sim.point(nut))[:2]
             now = float(np.arctan2(d[1], d[0]))
-            best = min(
-                (-1, 0, 1), key=lambda k: abs(wrap_angle(now + k * np.pi / 2 - np.pi, 2 * np.pi))
-            )
             cur = sim.data.site_xmat[sim._eef_site].reshape(3, 3)
-            turn.append(yaw_of(cur @ hand0.T) + best * np.pi / 2)
+            yaw = yaw_of(cur @ hand0.T)
+            if square:  # a square nut only slides down a square peg with edges lined up
+                body = sim.data.xmat[sim._body_id(sim.spec.object_spec(nut).body)]
+                yaw -= wrap_angle(yaw_of(body.reshape(3, 3)), np.pi / 2)
+                now -= wrap_angle(yaw_of(body.reshape(3, 3)), np.pi / 2)
+            # only turns the wrist can make without nearing its joint limit
+            ks = [k for k in (-1, 0, 1) if abs(yaw + k * np.pi / 2) <= MAX_WRIST_YAW] or [0]
+            best = min(ks, key=lambda k: abs(wrap_angle(now + k * np.pi / 2 - np.pi, 2 * np.pi)))
+            turn.append(yaw + best * np.pi / 2)
         return turn[0]
 
     return phases + [
@@ -217,6 +225,7 @@ SCRIPTS: dict[str, Callable[[SimEnv], list[Phase | Retry]]] = {
     "door": _door_script,
     "nut": _nut_script,
 }
+SCRIPTS.update(ARTICULATED_SCRIPTS)  # drawer, button, knob (rover's own fixtures)
 
 
 def run_expert(sim: SimEnv, seed: int) -> Demo:

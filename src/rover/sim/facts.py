@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from rover.episode import Event, FrameFacts, ObjectFacts, QAItem
+from rover.sim import articulation
 from rover.sim.env import SimEnv
 from rover.sim.tasks.base import TaskSpec
 
@@ -45,6 +46,10 @@ def frame_facts(sim: SimEnv) -> FrameFacts:
     if "door_open" in spec.goals:
         frac = sim.hinge_angle() / spec.goals["door_open"].angle
         articulations["door"] = round(float(np.clip(frac, 0.0, 1.0)), 3)
+    fixture_parts, pressed = articulation.articulation_facts(sim)
+    articulations.update(fixture_parts)
+    if holding is not None and not articulation.holdable(sim, holding):
+        holding = None  # a fingertip on a push button is not a hold
     return FrameFacts(
         gripper="closed" if opening < CLOSED_BELOW else "open",
         gripper_opening=round(opening, 3),
@@ -52,6 +57,7 @@ def frame_facts(sim: SimEnv) -> FrameFacts:
         holding=holding,
         objects=objects,
         articulations=articulations,
+        pressed=pressed,
         distances=distances,
     )
 
@@ -161,6 +167,8 @@ def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
                     frame=_first(facts, lambda f: f.articulations.get("door", 0.0) >= OPEN_FINISH),
                 )
             )
+        elif name in articulation.PARTS:
+            events += articulation.fixture_events(spec, name, facts)
     return events
 
 

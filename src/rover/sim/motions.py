@@ -221,7 +221,7 @@ PERIOD = {
 # tall objects: grasp this far above their centre so the palm clears their top (m)
 GRASP_DZ = {"milk": 0.045, "cereal": 0.035}
 YAW_OFFSET = {"cereal": np.pi / 2}
-OUTWARD = {"square nut": 0.015}
+OUTWARD = {"square nut": 0.0}
 
 
 def pick_retry(sim: SimEnv, obj: str, period, dz: float = 0.0, point=None) -> Retry:

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from rover.errors import InputError
-from rover.sim.tasks import composite, doors, pick, pick_place, stack
+from rover.sim.tasks import articulated, composite, doors, pick, pick_place, stack
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 _REGISTRY: dict[str, TaskSpec] = {
-    t.name: t for module in (pick, pick_place, stack, doors, composite) for t in module.TASKS
+    t.name: t
+    for module in (pick, pick_place, stack, doors, articulated, composite)
+    for t in module.TASKS
 }
 
 __all__ = [

@@ -18,7 +18,9 @@ from pydantic import BaseModel, Field
 
 from rover.sim.levels import LevelSpec
 
-TaskGroup = Literal["pick", "pick_and_place", "stacking", "doors", "composite"]
+TaskGroup = Literal[
+    "pick", "pick_and_place", "stacking", "doors", "composite", "drawers", "buttons", "knobs"
+]
 
 
 class ObjectSpec(BaseModel):
@@ -41,9 +43,11 @@ class GoalSpec(BaseModel):
         ``start_offset``: where ``object`` started the episode, plus ``offset`` (lift).
         ``door_open``: the ``object`` handle site rotated about the door hinge to
         ``angle`` radians (door opened).
+        ``fixture``: fixture site ``body`` with the fixture's joint at its target
+        (drawer pulled out, button pressed, knob turned; `rover.sim.articulation`).
     """
 
-    kind: Literal["bin", "above", "body", "start_offset", "door_open"]
+    kind: Literal["bin", "above", "body", "start_offset", "door_open", "fixture"]
     object: str | None = None
     body: str | None = None
     offset: tuple[float, float, float] = (0.0, 0.0, 0.0)

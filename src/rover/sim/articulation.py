@@ -1,0 +1,121 @@
+"""Predicates, goals, facts and events of the articulated fixtures (drawer, button, knob).
+
+The fixture environments (`rover.sim.fixtures`) expose their joint; this module turns
+it into what the generator speaks: end-of-subtask predicates (``drawer_opened:drawer``,
+``pressed:button``, ...), the ``fixture`` goal point of the value function, per-frame
+articulation facts and the events derived from them. The env wrapper, the facts code
+and the experts call in here, so the core files stay fixture-agnostic; nothing here
+imports robosuite (a sim that is not a fixture env simply has no articulations).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rover.episode import Event, FrameFacts
+
+if TYPE_CHECKING:  # pragma: no cover
+    from rover.sim.env import SimEnv
+    from rover.sim.tasks.base import GoalSpec, TaskSpec
+
+START = 0.05  # fraction of the motion at which "start opening/turning" happens
+FINISH = 0.9  # ... and "completely open/turned" (same as the fixture's success)
+CLOSED_AT = 0.12  # drawer opening fraction at or below which it reads as closed
+
+# end signals the fixtures answer: all mean "the fixture's joint reached its target"
+SIGNALS = ("drawer_opened", "drawer_closed", "pressed", "turned")
+PARTS = ("drawer", "button", "knob")  # articulated part (= task object) names
+
+
+def fixture(sim: SimEnv):
+    """The fixture environment behind `sim`, or None for robosuite's own tasks."""
+    env = sim.env
+    return env if hasattr(env, "joint_qpos_addr") and getattr(env, "part", "") else None
+
+
+def predicate(sim: SimEnv, kind: str, obj: str) -> bool | None:
+    """Evaluate ``kind:obj`` if it is a fixture signal; None when it is not one."""
+    if kind == "touched":
+        return obj in sim.finger_contacts()
+    fx = fixture(sim)
+    if kind in SIGNALS and fx is not None:
+        return bool(fx.reached())
+    return None
+
+
+def holdable(sim: SimEnv, name: str) -> bool:
+    """Whether both fingers on this object mean the robot holds it (not a push button)."""
+    return name != "button"
+
+
+def goal(sim: SimEnv, g: GoalSpec) -> np.ndarray:
+    """The ``fixture`` goal: where site `g.body` would be with the joint at its target."""
+    fx = fixture(sim)
+    if fx is None or g.body is None:
+        raise ValueError(f"goal kind 'fixture' needs a fixture environment and a site ({g})")
+    return fx.site_at(g.body, fx.target) + np.asarray(g.offset, dtype=np.float64)
+
+
+def articulation_facts(sim: SimEnv) -> tuple[dict[str, float], list[str]]:
+    """Articulation fractions of the fixture part and the parts pressed down now.
+
+    ``drawer``: opening fraction (0 closed, 1 fully open, also when closing it);
+    ``button``: press depth as a fraction of the switching depth, 1.0 once pressed;
+    ``knob``: fraction of the target turn.
+    """
+    fx = fixture(sim)
+    if fx is None:
+        return {}, []
+    if fx.part == "drawer":
+        value = fx.opening()
+    else:
+        value = fx.progress()
+    pressed = [fx.part] if fx.part == "button" and fx.pressed() else []
+    return {fx.part: round(float(value), 3)}, pressed
+
+
+def _first(facts: list[FrameFacts], test) -> int | None:
+    return next((t for t, f in enumerate(facts) if test(f)), None)
+
+
+def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[Event]:
+    """Events of an articulated part, the first frame at which the facts show each.
+
+    drawer: grasp, open_start/open_finish (or close_start/close_finish when the task
+    closes it); button: press and turn_on (the appliance switches on as the button
+    bottoms out); knob: grasp, turn_start, turn_finish.
+    """
+
+    def value(f: FrameFacts) -> float:
+        return f.articulations.get(name, 0.0)
+
+    def ev(event: str, frame: int | None) -> Event:
+        return Event(name=event, object=name, frame=frame)
+
+    signals = {s.end_signal.partition(":")[0] for s in spec.subtasks}
+    grasp = ev("grasp", _first(facts, lambda f: f.holding == name))
+    if name == "drawer" and "drawer_closed" in signals:
+        start = value(facts[0]) if facts else 1.0
+        return [
+            grasp,
+            ev("close_start", _first(facts, lambda f: value(f) <= start - START)),
+            ev("close_finish", _first(facts, lambda f: value(f) <= CLOSED_AT)),
+        ]
+    if name == "drawer":
+        return [
+            grasp,
+            ev("open_start", _first(facts, lambda f: value(f) >= START)),
+            ev("open_finish", _first(facts, lambda f: value(f) >= FINISH)),
+        ]
+    if name == "button":
+        press = _first(facts, lambda f: name in f.pressed)
+        return [ev("press", press), ev("turn_on", press)]
+    if name == "knob":
+        return [
+            grasp,
+            ev("turn_start", _first(facts, lambda f: value(f) >= START)),
+            ev("turn_finish", _first(facts, lambda f: value(f) >= FINISH)),
+        ]
+    return []

@@ -1,0 +1,210 @@
+"""Drawers, buttons and knobs groups (App. B): rover's own articulated fixtures.
+
+RoboCasa's OpenDrawer/CloseDrawer, TurnOnMicrowave/CoffeePressButton and
+TurnSinkSpout/TurnOnStove tasks need kitchen assets that cannot be downloaded here, so
+these tasks use small MJCF fixtures on robosuite's table (`rover.sim.fixtures`): a
+cabinet drawer, an appliance with a push button and a dial knob. Levels follow Table 5's
+rows for each group and QA templates follow App. C.3.
+"""
+
+from __future__ import annotations
+
+from rover.sim.tasks._common import FINGERS, named_levels
+from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
+
+DRAWER_START_OPEN = 0.14  # m; mirrors rover.sim.fixtures.drawer.START_OPEN (no robosuite here)
+
+_DRAWER = ObjectSpec(
+    name="drawer",
+    body="Drawer_drawer",
+    centre="Drawer_centre",
+    sites={"handle": "Drawer_handle"},
+    graspable=False,
+)
+
+
+def _qa(items: list[tuple[str, str, str]], obj: str) -> list[QATemplate]:
+    return [QATemplate(id=i, text=t, event=e, object=obj) for i, t, e in items]
+
+
+def _drawer_task(name: str, closing: bool) -> TaskSpec:
+    verb, signal = ("close", "drawer_closed") if closing else ("open", "drawer_opened")
+    ing = "closing" if closing else "opening"
+    push, end = ("push", "closed") if closing else ("pull", "open")
+    return TaskSpec(
+        name=name,
+        env_name="RoverDrawer",
+        env_kwargs={"start_q": DRAWER_START_OPEN, "target": 0.0} if closing else {},
+        description=f"Grasp the drawer handle and {push} the drawer {end}.",
+        group="drawers",
+        objects=[_DRAWER],
+        goals={f"drawer_{verb}": GoalSpec(kind="fixture", object="drawer", body="handle")},
+        subtasks=[
+            SubtaskSpec(
+                name="grasp the drawer handle",
+                object="drawer",
+                robot_points=FINGERS,
+                object_points=["drawer:handle", "drawer:handle"],
+                end_signal="grasped:drawer",
+            ),
+            SubtaskSpec(
+                name=f"{push} the drawer {end}",
+                object="drawer",
+                robot_points=FINGERS,
+                object_points=["drawer:handle", "drawer:handle"],
+                goal=f"goal:drawer_{verb}",
+                beta=0.8,
+                end_signal=f"{signal}:drawer",
+            ),
+        ],
+        levels=named_levels(
+            [["Approach the drawer"], [f"Start {ing} the drawer"]],
+            [
+                "Fail to approach the drawer",
+                "Approach the drawer",
+                "Contact the drawer",
+                f"Start {ing} the drawer",
+                f"Finish {ing} the drawer",
+            ],
+        ),
+        qa_templates=_qa(
+            [
+                ("did_contact", "Did the robot contact the drawer handle? If so, when?", "contact"),
+                ("did_grasp", "Did the robot grasp the drawer handle? If so, when?", "grasp"),
+                (
+                    f"did_{verb}_start",
+                    f"Did the robot start {ing} the drawer? If so, when?",
+                    f"{verb}_start",
+                ),
+                (
+                    f"did_{verb}_finish",
+                    f"Did the robot completely {verb} the drawer? If so, when?",
+                    f"{verb}_finish",
+                ),
+            ],
+            "drawer",
+        ),
+        expert="drawer_close" if closing else "drawer_open",
+        max_expert_steps=300,
+    )
+
+
+OPEN_DRAWER = _drawer_task("OpenDrawer", closing=False)
+CLOSE_DRAWER = _drawer_task("CloseDrawer", closing=True)
+
+PRESS_BUTTON = TaskSpec(
+    name="PressButton",
+    env_name="RoverButton",
+    description="Press the button to turn the appliance on.",
+    group="buttons",
+    objects=[
+        ObjectSpec(
+            name="button",
+            body="Button_button",
+            centre="Button_top",
+            sites={"top": "Button_top"},
+            graspable=False,
+        )
+    ],
+    goals={"button_pressed": GoalSpec(kind="fixture", object="button", body="top")},
+    subtasks=[
+        SubtaskSpec(
+            name="reach the button",
+            object="button",
+            robot_points=FINGERS,
+            object_points=["button:top", "button:top"],
+            end_signal="touched:button",
+        ),
+        SubtaskSpec(
+            name="press the button down",
+            object="button",
+            robot_points=FINGERS,
+            object_points=["button:top", "button:top"],
+            goal="goal:button_pressed",
+            beta=0.8,
+            end_signal="pressed:button",
+        ),
+    ],
+    levels=named_levels(
+        [[], []],
+        [
+            "Fail to approach the on/off button",
+            "Approach the on/off button",
+            "Press the button and turn the appliance on",
+        ],
+    ),
+    qa_templates=_qa(
+        [
+            ("did_contact", "Did the robot contact the button? If so, when?", "contact"),
+            ("did_press", "Did the robot press the button? If so, when?", "press"),
+            ("did_turn_on", "Did the robot turn the appliance on? If so, when?", "turn_on"),
+        ],
+        "button",
+    ),
+    expert="button",
+    max_expert_steps=200,
+)
+
+TURN_KNOB = TaskSpec(
+    name="TurnKnob",
+    env_name="RoverKnob",
+    description="Grasp the knob and turn it a quarter turn counter-clockwise.",
+    group="knobs",
+    objects=[
+        ObjectSpec(
+            name="knob",
+            body="Knob_knob",
+            centre="Knob_centre",
+            sites={"tip": "Knob_tip"},
+            graspable=False,
+        )
+    ],
+    goals={"knob_turned": GoalSpec(kind="fixture", object="knob", body="tip")},
+    subtasks=[
+        SubtaskSpec(
+            name="grasp the knob",
+            object="knob",
+            robot_points=FINGERS,
+            object_points=["knob", "knob"],
+            end_signal="grasped:knob",
+        ),
+        SubtaskSpec(
+            name="turn the knob",
+            object="knob",
+            robot_points=FINGERS,
+            object_points=["knob:tip", "knob:tip"],
+            goal="goal:knob_turned",
+            beta=0.8,
+            end_signal="turned:knob",
+        ),
+    ],
+    levels=named_levels(
+        [["Approach the knob"], ["Start turning the knob"]],
+        [
+            "Fail to approach the knob",
+            "Approach the knob",
+            "Contact the knob",
+            "Start turning the knob",
+            "Finish turning the knob",
+        ],
+    ),
+    qa_templates=_qa(
+        [
+            ("did_contact", "Did the robot contact the knob? If so, when?", "contact"),
+            ("did_grasp", "Did the robot grasp the knob? If so, when?", "grasp"),
+            ("did_turn_start", "Did the robot start turning the knob? If so, when?", "turn_start"),
+            (
+                "did_turn_finish",
+                "Did the robot completely turn the knob? If so, when?",
+                "turn_finish",
+            ),
+        ],
+        "knob",
+    ),
+    expert="knob",
+    max_expert_steps=250,
+)
+
+# every articulated task; the registry takes those whose expert passed the 90% bar
+ALL_TASKS = [OPEN_DRAWER, PRESS_BUTTON, TURN_KNOB, CLOSE_DRAWER]
+TASKS = ALL_TASKS
