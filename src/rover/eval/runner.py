@@ -304,30 +304,54 @@ class Runner:
         return trace
 
     async def _judge(self, ref: EpisodeRef, episode: Episode, trace: Trace, v: Variant) -> None:
-        self.rundir.log_unit(ref.id, v.id, "judge", "start")
-        if self.judge_vlm is None:
-            result = await asyncio.to_thread(rule_judge_trace, trace, episode, v.id)
-        else:
-            vlm = self.judge_vlm.bind(episode)
-            result = await llm_judge_trace(trace, episode, v.id, vlm, self.opts.judge)
-        await asyncio.to_thread(
-            write_json_atomic, self.rundir.stage_path("judge", ref.id, v.id), result
+        await self._scoring_stage(
+            "judge",
+            ref,
+            episode,
+            trace,
+            v,
+            rule=rule_judge_trace,
+            llm=llm_judge_trace,
+            vlm=self.judge_vlm,
+            spec=self.opts.judge,
         )
-        self.rundir.log_unit(ref.id, v.id, "judge", "done", calls=result.calls)
-        self.state.calls += result.calls
-        self.state.tokens += result.total_tokens
 
     async def _qa(self, ref: EpisodeRef, episode: Episode, trace: Trace, v: Variant) -> None:
-        self.rundir.log_unit(ref.id, v.id, "qa", "start")
-        if self.answer_vlm is None:
-            result = await asyncio.to_thread(rule_answer_trace, trace, episode, v.id)
-        else:
-            vlm = self.answer_vlm.bind(episode)
-            result = await llm_answer_trace(trace, episode, v.id, vlm, self.opts.answerer)
-        await asyncio.to_thread(
-            write_json_atomic, self.rundir.stage_path("qa", ref.id, v.id), result
+        await self._scoring_stage(
+            "qa",
+            ref,
+            episode,
+            trace,
+            v,
+            rule=rule_answer_trace,
+            llm=llm_answer_trace,
+            vlm=self.answer_vlm,
+            spec=self.opts.answerer,
         )
-        self.rundir.log_unit(ref.id, v.id, "qa", "done", calls=result.calls)
+
+    async def _scoring_stage(
+        self,
+        stage: str,
+        ref: EpisodeRef,
+        episode: Episode,
+        trace: Trace,
+        v: Variant,
+        *,
+        rule,
+        llm,
+        vlm,
+        spec: str,
+    ) -> None:
+        """Score a finished trace (judge or QA) offline by rule or through an LLM."""
+        self.rundir.log_unit(ref.id, v.id, stage, "start")
+        if vlm is None:
+            result = await asyncio.to_thread(rule, trace, episode, v.id)
+        else:
+            result = await llm(trace, episode, v.id, vlm.bind(episode), spec)
+        await asyncio.to_thread(
+            write_json_atomic, self.rundir.stage_path(stage, ref.id, v.id), result
+        )
+        self.rundir.log_unit(ref.id, v.id, stage, "done", calls=result.calls)
         self.state.calls += result.calls
         self.state.tokens += result.total_tokens
 
