@@ -26,9 +26,7 @@ from rover.methods.trace import Trace
 
 log = logging.getLogger(__name__)
 
-# files that may name the dataset a run was made from, and the keys that may hold it
-_CONFIG_FILES = ("run.json", "config.json", "manifest.json", "eval.json")
-_DATASET_KEYS = ("dataset", "dataset_dir", "dataset_path", "data")
+RUN_CONFIG = "run.json"  # written by `rover eval` (docs/evaluation.md)
 
 DISPLAY_NAMES = {
     "rover": "ROVER",
@@ -205,18 +203,15 @@ def _load_traces(run_dir: Path) -> list[TraceEntry]:
 
 
 def _load_config(run_dir: Path) -> dict[str, Any]:
-    merged: dict[str, Any] = {}
-    for name in _CONFIG_FILES:
-        path = run_dir / name
-        if path.exists():
-            try:
-                raw = json.loads(path.read_text())
-            except json.JSONDecodeError:
-                continue
-            if isinstance(raw, dict):
-                for k, v in raw.items():
-                    merged.setdefault(k, v)
-    return merged
+    path = run_dir / RUN_CONFIG
+    if not path.exists():
+        return {}
+    try:
+        raw = json.loads(path.read_text())
+    except json.JSONDecodeError:
+        log.warning("skipping %s: not valid JSON", path)
+        return {}
+    return raw if isinstance(raw, dict) else {}
 
 
 def _load_aggregates(path: Path) -> list[dict[str, Any]]:
@@ -231,18 +226,12 @@ def _load_aggregates(path: Path) -> list[dict[str, Any]]:
 
 
 def _dataset_from_config(run_dir: Path, config: dict[str, Any]) -> Path | None:
-    candidates: list[Any] = [config.get(k) for k in _DATASET_KEYS]
-    nested = config.get("config")
-    if isinstance(nested, dict):
-        candidates += [nested.get(k) for k in _DATASET_KEYS]
-    for c in candidates:
-        if isinstance(c, dict):
-            c = c.get("path") or c.get("root")
-        if isinstance(c, str) and c:
-            p = Path(c)
-            for base in (p, run_dir / p):
-                if (base / DATASET_FILE).exists():
-                    return base
+    """The dataset a run was made from: run.json's `dataset` (absolute or run-relative)."""
+    c = config.get("dataset")
+    if isinstance(c, str) and c:
+        for base in (Path(c), run_dir / c):
+            if (base / DATASET_FILE).exists():
+                return base
     if (run_dir / "dataset" / DATASET_FILE).exists():
         return run_dir / "dataset"
     return None
