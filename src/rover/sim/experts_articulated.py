@@ -17,6 +17,7 @@ from rover.sim.motions import CLOSE, OPEN, Phase
 
 LEAD = 0.04  # m (drawer) the pull/push target runs ahead of the handle
 TURN_LEAD = 0.35  # rad the hand's yaw runs ahead of the knob while turning
+KNOB_DZ = 0.022  # m above the knob's centre the fingers grip it
 
 
 def _latch(sim: SimEnv) -> Callable[[], np.ndarray]:
@@ -88,8 +89,8 @@ def knob_script(sim: SimEnv) -> list[Phase]:
     fx = sim.env
     yaw0 = fx.fixture_yaw() + np.pi / 2  # fingers across the knob, clear of the lever
 
-    def grip() -> np.ndarray:
-        return sim.point("knob")
+    def grip() -> np.ndarray:  # the upper part of the knob: the palm clears its top
+        return sim.point("knob") + np.array([0.0, 0.0, KNOB_DZ])
 
     def turning_yaw() -> float:
         return yaw0 + min(fx.joint_value() + TURN_LEAD, fx.target + 0.15)
