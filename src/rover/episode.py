@@ -172,9 +172,8 @@ class Episode(BaseModel):
             raise ValueError(f"episode {self.id!r}: frame_indices must be strictly increasing")
         if self.truth is not None:
             if len(self.truth.progress) != n:
-                raise ValueError(
-                    f"episode {self.id!r}: {len(self.truth.progress)} progress values for {n} frames"
-                )
+                got = len(self.truth.progress)
+                raise ValueError(f"episode {self.id!r}: {got} progress values for {n} frames")
             if self.truth.state_type is not None and len(self.truth.state_type) != n:
                 raise ValueError(f"episode {self.id!r}: state_type length != {n} frames")
             if self.truth.facts is not None and len(self.truth.facts) != n:

@@ -20,9 +20,11 @@ if TYPE_CHECKING:  # pragma: no cover
     from rover.sim.env import SimEnv
     from rover.sim.tasks.base import GoalSpec, TaskSpec
 
-START = 0.05  # fraction of the motion at which "start opening/turning" happens
-FINISH = 0.9  # ... and "completely open/turned" (same as the fixture's success)
-CLOSED_AT = 0.12  # drawer opening fraction at or below which it reads as closed
+# thresholds on the articulation fraction, the same as the rule judge's reading of
+# "x% open" (rover.eval.rule_judge), so oracle descriptions and events agree
+START = 0.1  # "start opening/turning": more than this; "start closing": below FINISH
+FINISH = 0.9  # "completely open/turned": at least this (the fixture's success too)
+CLOSED_AT = 0.1  # "completely closed": drawer opening fraction at most this
 
 # end signals the fixtures answer: all mean "the fixture's joint reached its target"
 SIGNALS = ("drawer_opened", "drawer_closed", "pressed", "turned")
@@ -62,18 +64,22 @@ def articulation_facts(sim: SimEnv) -> tuple[dict[str, float], list[str]]:
     """Articulation fractions of the fixture part and the parts pressed down now.
 
     ``drawer``: opening fraction (0 closed, 1 fully open, also when closing it);
-    ``button``: press depth as a fraction of the switching depth, 1.0 once pressed;
+    ``button``: 1.0 while pressed past the switching depth (the appliance is on), else 0.0;
     ``knob``: fraction of the target turn.
     """
     fx = fixture(sim)
     if fx is None:
         return {}, []
+    pressed = [fx.part] if fx.part == "button" and fx.pressed() else []
     if fx.part == "drawer":
         value = fx.opening()
+    elif fx.part == "button":  # on/off: a half-pressed button has not switched anything
+        value = 1.0 if pressed else 0.0
     else:
         value = fx.progress()
-    pressed = [fx.part] if fx.part == "button" and fx.pressed() else []
-    return {fx.part: round(float(value), 3)}, pressed
+    # whole percent, as descriptions state it ("The drawer is 90% open."): events read
+    # from these facts then fall on the same frame as the description that asserts them
+    return {fx.part: round(float(value), 2)}, pressed
 
 
 def _first(facts: list[FrameFacts], test) -> int | None:
@@ -95,18 +101,23 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
         return Event(name=event, object=name, frame=frame)
 
     signals = {s.end_signal.partition(":")[0] for s in spec.subtasks}
-    grasp = ev("grasp", _first(facts, lambda f: f.holding == name))
+    # a grasp, as for free objects: held, or touched with the gripper closed
+    grasp = ev(
+        "grasp",
+        _first(
+            facts, lambda f: f.holding == name or (name in f.contacts and f.gripper == "closed")
+        ),
+    )
     if name == "drawer" and "drawer_closed" in signals:
-        start = value(facts[0]) if facts else 1.0
         return [
             grasp,
-            ev("close_start", _first(facts, lambda f: value(f) <= start - START)),
+            ev("close_start", _first(facts, lambda f: value(f) < FINISH)),
             ev("close_finish", _first(facts, lambda f: value(f) <= CLOSED_AT)),
         ]
     if name == "drawer":
         return [
             grasp,
-            ev("open_start", _first(facts, lambda f: value(f) >= START)),
+            ev("open_start", _first(facts, lambda f: value(f) > START)),
             ev("open_finish", _first(facts, lambda f: value(f) >= FINISH)),
         ]
     if name == "button":
@@ -115,7 +126,7 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
     if name == "knob":
         return [
             grasp,
-            ev("turn_start", _first(facts, lambda f: value(f) >= START)),
+            ev("turn_start", _first(facts, lambda f: value(f) > START)),
             ev("turn_finish", _first(facts, lambda f: value(f) >= FINISH)),
         ]
     return []
