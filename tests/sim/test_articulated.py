@@ -94,6 +94,11 @@ def test_expert_moves_the_part_and_events_match_facts(name, sim_env):
     elif name == "PressButton":
         assert part in facts[t].pressed and all(part not in f.pressed for f in facts[:t])
         assert events["turn_on"] == t
+        lamp = []
+        for state in demo.states[[0, -1]]:
+            sim.set_state(state)
+            lamp.append(sim._named_xpos("Button_lamp")[2])
+        assert lamp[1] - lamp[0] > 0.02  # the "on" lamp rose out of the case
     else:
         assert value[t] >= 0.9 and all(v < 0.9 for v in value[:t])
     if start is not None:
