@@ -95,3 +95,20 @@ def test_rule_answerer_reads_event_from_question_text() -> None:
     done = QAItem(question="Did the robot completely open the door? If so, when?", answer=True)
     assert first_event_position(start, states, []) == 1
     assert first_event_position(done, states, []) == 2
+
+
+def test_rule_answerer_reads_turning_an_appliance_on_from_the_button() -> None:
+    states = asserted_states(
+        [
+            "The button is not pressed.",
+            "The gripper is touching the button.",
+            "The button is pressed.",
+        ]
+    )
+    on = QAItem(
+        question="Did the robot turn the appliance on? If so, when?",
+        answer=True,
+        event="turn_on",
+        object="button",
+    )
+    assert first_event_position(on, states, []) == 2

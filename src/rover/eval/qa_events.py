@@ -179,6 +179,13 @@ def _event_here(ev: str, obj: str, target: str | None, a: Asserted, was_held: bo
         return was_held and released and not placed
     if ev == "press":
         return _get(a.pressed, obj) is True
+    if ev in ("turn_on", "turn_off"):
+        # an appliance switched by a push button: "on" is said as the button being pressed
+        pressed = _get(a.pressed, obj)
+        if pressed is None and obj != "button":
+            pressed = _get(a.pressed, "button")
+        if pressed is not None:
+            return pressed is (ev == "turn_on")
     value = _get(a.parts, obj)
     if not isinstance(value, float):
         return False
