@@ -71,16 +71,7 @@ def bar_axes(ax, rows, metric, label, variants, colors, key, xlabel, attr="varia
         ]
         means = [s[0] for s in stats_]
         ses = [s[1] for s in stats_]
-        ax.bar(
-            x + (i - (len(variants) - 1) / 2) * width,
-            means,
-            width,
-            yerr=ses,
-            color=colors[v],
-            label=v,
-            capsize=2,
-            error_kw={"elinewidth": 0.8},
-        )
+        _grouped_bars(ax, x, i, len(variants), width, means, ses, colors[v], v)
     ax.set_xticks(x, [str(g) for g in groups], rotation=20 if len(groups) > 4 else 0)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(label)
@@ -286,16 +277,7 @@ def strata_bars(agg: list[dict], label: str, variants: list[str], colors: dict[s
             ses = [
                 cell[g]["se"] if g in cell and cell[g]["se"] is not None else np.nan for g in groups
             ]
-            ax.bar(
-                x + (i - (len(shown) - 1) / 2) * width,
-                means,
-                width,
-                yerr=ses,
-                color=colors[v],
-                label=v,
-                capsize=2,
-                error_kw={"elinewidth": 0.8},
-            )
+            _grouped_bars(ax, x, i, len(shown), width, means, ses, colors[v], v)
         ax.set_xticks(x, [g.replace("_", "-") for g in groups])
         ax.set_xlabel(xlabel)
         ax.set_ylabel(label)
@@ -303,3 +285,17 @@ def strata_bars(agg: list[dict], label: str, variants: list[str], colors: dict[s
         ax.grid(axis="y", alpha=0.3)
     legend(fig, axes[0] if axes[0].get_visible() else axes[1])
     return fig
+
+
+def _grouped_bars(ax, x, i: int, n: int, width: float, means, ses, color, label: str) -> None:
+    """Series i of n side by side at each group position, with standard-error whiskers."""
+    ax.bar(
+        x + (i - (n - 1) / 2) * width,
+        means,
+        width,
+        yerr=ses,
+        color=color,
+        label=label,
+        capsize=2,
+        error_kw={"elinewidth": 0.8},
+    )
