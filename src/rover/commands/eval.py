@@ -208,6 +208,16 @@ def eval_command(
         raise typer.Exit(1)
 
 
+_SHORT_HEADERS = {
+    "Pearson r": "r",
+    "Error rate": "err",
+    "Success rate": "succ",
+    "QA acc.": "QA",
+    "Tokens/video": "tokens",
+    "Calls/video": "calls",
+}
+
+
 def _print_main_table(metrics: dict, oracle: bool = False) -> None:
     from rover.eval.summary import main_rows
 
@@ -217,7 +227,14 @@ def _print_main_table(metrics: dict, oracle: bool = False) -> None:
         title += "\nORACLE OUTPUT: oracle rows answer from ground truth, not a VLM"
     table = Table(title=title)
     for h in headers:
-        table.add_column(h, overflow="fold", no_wrap=h == "Method")
+        # numbers never fold (short headers keep them narrow); long method names wrap
+        is_name = h == "Method"
+        table.add_column(
+            _SHORT_HEADERS.get(h, h),
+            no_wrap=not is_name,
+            overflow="fold" if is_name else "ellipsis",
+            justify="left" if is_name else "right",
+        )
     for r in rows:
         table.add_row(*r)
     Console().print(table)
