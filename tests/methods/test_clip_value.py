@@ -77,3 +77,29 @@ async def test_clip_value_needs_a_model(make_episode, tmp_path):
         await get_method("clip-value").run(make_episode(3), None)
     with pytest.raises(InputError, match="does not exist"):
         await get_method("clip-value", model_path=tmp_path / "nope").run(make_episode(3), None)
+
+
+@pytest.mark.hf
+@pytest.mark.slow
+def test_clip_value_through_rover_eval(make_episode, tiny_clip, tmp_path):
+    """`rover eval --methods clip-value --model-path` scores the embedding baseline too."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from rover.cli import app
+    from rover.io.dataset import DatasetInfo, write_dataset_info, write_episode
+
+    ds = tmp_path / "ds"
+    write_dataset_info(ds, DatasetInfo(name="t", views=["left"]))
+    write_episode(ds, make_episode(6, episode_id="a"))
+    out = tmp_path / "run"
+    args = ["eval", "--dataset", str(ds), "--methods", "clip-value,rover", "--out", str(out)]
+    missing = CliRunner().invoke(app, args)
+    assert missing.exit_code != 0 and "--model-path" in str(missing.exception or missing.output)
+    done = CliRunner().invoke(app, [*args, "--model-path", str(tiny_clip)])
+    assert done.exit_code == 0, done.output
+    rows = json.loads((out / "metrics.json").read_text())["per_trace"]
+    assert {r["method"] for r in rows} == {"clip-value", "rover"}
+    clip = next(r for r in rows if r["method"] == "clip-value")
+    assert clip["calls"] == 0

@@ -102,6 +102,10 @@ def eval_command(
             "--jitter", help="Oracle noise: std. dev. of progress noise (percentage points)."
         ),
     ] = None,
+    model_path: Annotated[
+        Path | None,
+        typer.Option("--model-path", help="clip-value: local CLIP/SigLIP model folder."),
+    ] = None,
     oracle_seed: Annotated[
         int | None, typer.Option("--oracle-seed", help="Oracle noise seed.")
     ] = None,
@@ -166,6 +170,7 @@ def eval_command(
         seed=seed,
         out=out,
         resume=resume,
+        model_path=model_path,
         backend_config=config,
         command=["rover"] + sys.argv[1:],
     )

@@ -61,6 +61,7 @@ class EvalOptions(BaseModel):
     seed: int = 0
     out: Path
     resume: bool = False
+    model_path: Path | None = None  # clip-value: local CLIP/SigLIP folder
     backend_config: BackendConfig = Field(default_factory=BackendConfig)
     command: list[str] = Field(default_factory=list)
 
@@ -356,8 +357,17 @@ class Runner:
         self.state.tokens += result.total_tokens
 
 
+def method_params(opts: EvalOptions) -> dict[str, dict[str, Any]]:
+    """Fixed per-method parameters from the options (clip-value's local model)."""
+    if opts.model_path is None:
+        return {}
+    return {"clip-value": {"model_path": str(opts.model_path)}}
+
+
 def build_variants(opts: EvalOptions) -> list[Variant]:
-    return expand_variants(opts.methods, opts.backends, opts.frames, opts.windows, opts.views)
+    return expand_variants(
+        opts.methods, opts.backends, opts.frames, opts.windows, opts.views, method_params(opts)
+    )
 
 
 def prepare_run(
@@ -372,6 +382,11 @@ def prepare_run(
         InputError: unknown method, bad sweep value, missing dataset, non-empty --out...
     """
     check_methods(opts.methods)
+    if "clip-value" in opts.methods:
+        if opts.model_path is None:
+            raise InputError("clip-value needs --model-path: a local CLIP or SigLIP folder")
+        if not Path(opts.model_path).is_dir():
+            raise InputError(f"--model-path {opts.model_path}: no such folder")
     variants = build_variants(opts)
     refs = episode_refs(opts)
     _warm_up()

@@ -64,8 +64,13 @@ def expand_variants(
     frames: list[int | None],
     windows: list[int | None],
     views: list[str | None],
+    method_params: dict[str, dict[str, Any]] | None = None,
 ) -> list[Variant]:
-    """Every combination, in a stable order; windows apply only to windowed methods."""
+    """Every combination, in a stable order; windows apply only to windowed methods.
+
+    `method_params` adds fixed parameters for one method in every variant (for example
+    clip-value's `model_path`); they do not enter the variant id.
+    """
     if not methods:
         raise InputError("--methods: give at least one method")
     if not backends:
@@ -79,6 +84,7 @@ def expand_variants(
             continue
         seen.add(vid)
         params = {"window": window} if window is not None else {}
+        params.update((method_params or {}).get(method, {}))
         out.append(
             Variant(
                 id=vid,
