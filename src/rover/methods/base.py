@@ -15,7 +15,7 @@ from datetime import UTC, datetime
 from typing import Any, TypeVar
 
 from rover.episode import Episode
-from rover.methods.trace import CallRecord, FrameRecord, Trace
+from rover.methods.trace import CallRecord, Trace
 from rover.vlm.types import (
     VLM,
     Completion,
@@ -71,21 +71,8 @@ class Session:
         self.encoding: ImageEncoding = getattr(vlm, "image_encoding", None) or ImageEncoding()
         self._parts: dict[int, ImagePart] = {}
         self.lines_started = 0  # ROVER: ids for lines of reasoning
-        self.trace = Trace(
-            method=method.name,
-            params=dict(method.params),
-            backend=vlm.backend,
-            model=vlm.model,
-            oracle=is_oracle(vlm),
-            episode_id=episode.id,
-            task=episode.task,
-            view=episode.view,
-            num_frames=episode.num_frames,
-            frame_indices=list(episode.frame_indices),
-            frames=[
-                FrameRecord(index=idx, position=pos)
-                for pos, idx in enumerate(episode.frame_indices)
-            ],
+        self.trace = Trace.start(
+            episode, method.name, method.params, vlm.backend, vlm.model, oracle=is_oracle(vlm)
         )
 
     @property

@@ -20,7 +20,7 @@ import numpy as np
 from rover.episode import Episode
 from rover.errors import InputError, MissingExtraError
 from rover.methods.base import Method, OnStep
-from rover.methods.trace import FrameRecord, Totals, Trace
+from rover.methods.trace import Totals, Trace
 
 
 def _as_tensor(out: Any) -> Any:
@@ -101,28 +101,13 @@ class ClipValue(Method):
         frames = episode.frames()
         sims = await asyncio.to_thread(self.similarities, frames, episode.task)
         progress = self.to_progress(sims)
-        trace = Trace(
-            method=self.name,
-            params=dict(self.params),
-            backend="embedding",
-            model=self.model_path.name if self.model_path else "",
-            episode_id=episode.id,
-            task=episode.task,
-            view=episode.view,
-            num_frames=episode.num_frames,
-            frame_indices=list(episode.frame_indices),
-            frames=[
-                FrameRecord(
-                    index=idx,
-                    position=pos,
-                    progress=progress[pos],
-                    predicted=True,
-                    subtask_progress=float(sims[pos]),
-                )
-                for pos, idx in enumerate(episode.frame_indices)
-            ],
-            totals=Totals(latency_s=time.perf_counter() - t0),
-        )
+        model = self.model_path.name if self.model_path else ""
+        trace = Trace.start(episode, self.name, self.params, "embedding", model)
+        for fr in trace.frames:
+            fr.progress = progress[fr.position]
+            fr.predicted = True
+            fr.subtask_progress = float(sims[fr.position])
+        trace.totals = Totals(latency_s=time.perf_counter() - t0)
         if on_step is not None:
             from rover.methods.base import StepInfo
 

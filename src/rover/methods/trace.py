@@ -9,9 +9,12 @@ from __future__ import annotations
 
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import BaseModel, Field
+
+if TYPE_CHECKING:
+    from rover.episode import Episode
 
 TRACE_SCHEMA_VERSION = 1
 
@@ -91,6 +94,34 @@ class Trace(BaseModel):
     started_at: str = Field(default_factory=lambda: datetime.now(UTC).isoformat())
     finished_at: str | None = None
     error: str | None = None
+
+    @classmethod
+    def start(
+        cls,
+        episode: Episode,
+        method: str,
+        params: dict[str, Any],
+        backend: str,
+        model: str,
+        oracle: bool = False,
+    ) -> Trace:
+        """An empty trace for one run: one unpredicted FrameRecord per sampled frame."""
+        return cls(
+            method=method,
+            params=dict(params),
+            backend=backend,
+            model=model,
+            oracle=oracle,
+            episode_id=episode.id,
+            task=episode.task,
+            view=episode.view,
+            num_frames=episode.num_frames,
+            frame_indices=list(episode.frame_indices),
+            frames=[
+                FrameRecord(index=idx, position=pos)
+                for pos, idx in enumerate(episode.frame_indices)
+            ],
+        )
 
     def progress(self) -> list[float]:
         """Full-task progress per sampled frame (0..100), None replaced by 0."""
