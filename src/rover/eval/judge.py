@@ -119,21 +119,23 @@ def _has_facts(episode: Episode) -> bool:
     return episode.truth is not None and episode.truth.facts is not None
 
 
+def _record(index: int, pos: int, j: FrameJudgement) -> FrameVerdictRecord:
+    """One frame's stored verdict from a judgement (rule judge or parsed LLM reply)."""
+    return FrameVerdictRecord(
+        index=index,
+        position=pos,
+        verdict=j.verdict,
+        true_claims=j.true_claims,
+        false_claims=j.false_claims,
+        reason=j.reason,
+    )
+
+
 def rule_judge_trace(trace: Trace, episode: Episode, variant: str) -> Judgements:
     """Judge every frame of a trace with the offline rule judge."""
     verdicts = []
     for index, pos, desc, facts in _frames(trace, episode):
-        j = judge_description(desc, facts)
-        verdicts.append(
-            FrameVerdictRecord(
-                index=index,
-                position=pos,
-                verdict=j.verdict,
-                true_claims=j.true_claims,
-                false_claims=j.false_claims,
-                reason=j.reason,
-            )
-        )
+        verdicts.append(_record(index, pos, judge_description(desc, facts)))
     return Judgements(
         episode_id=episode.id,
         variant=variant,
@@ -166,15 +168,7 @@ async def llm_judge_trace(
         completion = await vlm.complete(prompt, params)
         usage["calls"] += 1
         usage["tokens"] += completion.usage.total_tokens
-        j = parse_judge_reply(completion.text)
-        return FrameVerdictRecord(
-            index=index,
-            position=pos,
-            verdict=j.verdict,
-            true_claims=j.true_claims,
-            false_claims=j.false_claims,
-            reason=j.reason,
-        )
+        return _record(index, pos, parse_judge_reply(completion.text))
 
     verdicts = await asyncio.gather(*(one(*f) for f in _frames(trace, episode)))
     return Judgements(
