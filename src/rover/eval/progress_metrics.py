@@ -88,12 +88,7 @@ def pearson(pred: np.ndarray, truth: np.ndarray) -> tuple[float, bool]:
     pred, truth = np.asarray(pred, float), np.asarray(truth, float)
     if len(pred) < 2 or _is_constant(truth):
         return math.nan, False
-    if _is_constant(pred):
-        return 0.0, True
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        r = float(stats.pearsonr(pred, truth).statistic)
-    return (0.0, True) if math.isnan(r) else (r, False)
+    return _correlation(stats.pearsonr, pred, truth)
 
 
 def l2_distance(pred: np.ndarray, truth: np.ndarray) -> float:
@@ -108,12 +103,17 @@ def voc(pred: np.ndarray, order: np.ndarray | None = None) -> tuple[float, bool]
     order = np.arange(len(pred)) if order is None else np.asarray(order, float)
     if len(pred) < 2:
         return math.nan, False
+    return _correlation(stats.spearmanr, pred, order)
+
+
+def _correlation(fn, pred: np.ndarray, other: np.ndarray) -> tuple[float, bool]:
+    """(statistic, prediction_was_constant): a constant or degenerate prediction scores 0."""
     if _is_constant(pred):
         return 0.0, True
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        rho = float(stats.spearmanr(pred, order).statistic)
-    return (0.0, True) if math.isnan(rho) else (rho, False)
+        r = float(fn(pred, other).statistic)
+    return (0.0, True) if math.isnan(r) else (r, False)
 
 
 def score_progress(trace: Trace, episode: Episode) -> ProgressScores:
