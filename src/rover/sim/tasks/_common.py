@@ -12,20 +12,11 @@ FINGERS = ["left_finger", "right_finger"]
 
 def grasp_subtask(name: str, obj: str, point: str | None = None, signal: str = "") -> SubtaskSpec:
     """Bring both fingers to the object (no goal term): "pick up the can"."""
-    where = point or obj
-    return SubtaskSpec(
-        name=name,
-        object=obj,
-        robot_points=FINGERS,
-        object_points=[where, where],
-        goal=None,
-        beta=0.0,
-        end_signal=signal or f"lifted:{obj}",
-    )
+    return move_subtask(name, obj, None, signal or f"lifted:{obj}", beta=0.0, point=point)
 
 
 def move_subtask(
-    name: str, obj: str, goal: str, signal: str, beta: float = 0.8, point: str | None = None
+    name: str, obj: str, goal: str | None, signal: str, beta: float = 0.8, point: str | None = None
 ) -> SubtaskSpec:
     """Carry the object to a goal point, mostly measured by the object-goal distance."""
     where = point or obj
