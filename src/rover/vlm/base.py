@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 from rover.vlm.cache import ResponseCache, cache_key
 from rover.vlm.config import BackendConfig, TokenRule
-from rover.vlm.retry import ErrorInfo, RetryPolicy, call_with_retries
+from rover.vlm.retry import ErrorInfo, RetryPolicy, call_with_retries, classify_common
+from rover.vlm.scrub import scrub
 from rover.vlm.tokens import default_rule, estimate_usage
 from rover.vlm.types import Completion, ImageEncoding, Prompt, SamplingParams, Usage
 
@@ -63,6 +64,11 @@ class BaseBackend:
         """Backend settings that change answers and so belong in the cache key."""
         return {}
 
+    def endpoint(self) -> str:
+        """Which server answers (its URL without credentials); part of the cache key, so two
+        deployments serving the same model name never share answers."""
+        return ""
+
     # --- public interface --------------------------------------------------------------
 
     @property
@@ -92,7 +98,12 @@ class BaseBackend:
         key = ""
         if cache is not None:
             key = cache_key(
-                self.backend, self.model, prompt.fingerprint(), params, self.cache_extra()
+                self.backend,
+                self.model,
+                prompt.fingerprint(),
+                params,
+                self.cache_extra(),
+                endpoint=self.endpoint(),
             )
             hit = cache.get(key)
             if hit is not None:
@@ -101,14 +112,17 @@ class BaseBackend:
             start = time.perf_counter()
             raw = await call_with_retries(
                 lambda: self._generate(prompt, params),
-                self._classify,
+                self._classify_any,
                 self._retry_policy(),
                 self.spec,
             )
             latency = time.perf_counter() - start
-        usage = raw.usage or estimate_usage(prompt, raw.text, self.token_rule)
+        # a server may echo a key or credentials in its answer: scrub before it is cached,
+        # recorded, parsed into a trace or shown
+        text = scrub(raw.text)
+        usage = raw.usage or estimate_usage(prompt, text, self.token_rule)
         completion = Completion(
-            text=raw.text,
+            text=text,
             usage=usage,
             latency_s=latency,
             cached=False,
@@ -138,7 +152,12 @@ class BaseBackend:
             timeout_s=c.timeout_s,
             base_wait_s=c.retry_base_wait_s,
             max_wait_s=c.retry_max_wait_s,
+            timeout_retries=c.timeout_retries,
         )
+
+    def _classify_any(self, exc: BaseException) -> ErrorInfo | None:
+        """The provider's verdict, else the shared one for unreadable bodies."""
+        return self._classify(exc) or classify_common(exc)
 
     def _response_cache(self) -> ResponseCache | None:
         if not self.use_cache or self.config.no_cache:

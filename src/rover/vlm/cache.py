@@ -2,10 +2,12 @@
 
 A rerun of the same method on the same frames with the same model and sampling settings
 costs nothing: the answer comes back from disk with `cached=True`. The key is a hash of
-(backend, model, prompt fingerprint, sampling parameters, backend extras) — never of an
-API key, which is not part of any answer. WAL mode and a busy timeout let many threads and
-processes write at once; each thread has its own connection (sqlite3 connections must not
-be shared across threads).
+everything that can change an answer: backend kind, endpoint (the base URL, without
+credentials: two vLLM deployments serving the same model name are different models),
+model, prompt fingerprint (text and image bytes), sampling parameters and output budget,
+backend extras — never of an API key, which is not part of any answer. WAL mode and a
+busy timeout let many threads and processes write at once; each thread has its own
+connection (sqlite3 connections must not be shared across threads).
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from typing import Any
 from rover.errors import InputError
 from rover.vlm.types import Completion, SamplingParams, Usage
 
-CACHE_SCHEMA_VERSION = 1
+CACHE_SCHEMA_VERSION = 2  # 2: the endpoint is part of the key
 BUSY_TIMEOUT_MS = 30_000
 
 _SCHEMA = """
@@ -43,11 +45,14 @@ def cache_key(
     fingerprint: str,
     params: SamplingParams,
     extra: dict[str, Any] | None = None,
+    *,
+    endpoint: str = "",
 ) -> str:
     """The hash that identifies one answer: same key, same question to the same model."""
     payload = {
         "v": CACHE_SCHEMA_VERSION,
         "backend": backend,
+        "endpoint": endpoint,
         "model": model,
         "prompt": fingerprint,
         "params": params.model_dump(mode="json"),

@@ -28,11 +28,49 @@ def default_cache_path() -> Path:
     return base / DEFAULT_CACHE_FILE
 
 
+BACKEND_ENV = "ROVER_BACKEND"
+CONFIG_ENV = "ROVER_CONFIG"
+
+
+def config_file_path() -> Path:
+    """`$ROVER_CONFIG`, else `~/.config/rover/config.toml` (it need not exist)."""
+    given = os.environ.get(CONFIG_ENV)
+    return Path(given).expanduser() if given else Path.home() / ".config" / "rover" / "config.toml"
+
+
+def default_backend() -> str | None:
+    """The VLM spec the user chose once for all commands, or None when they chose none.
+
+    `ROVER_BACKEND` wins over the config file's top-level `backend = "..."`. There is no
+    built-in default: a silent one would either spend money or (the oracle) refuse real
+    videos, so commands ask for an explicit choice instead.
+    """
+    env = os.environ.get(BACKEND_ENV, "").strip()
+    if env:
+        return env
+    path = config_file_path()
+    if not path.is_file():
+        return None
+    import tomllib
+
+    from rover.errors import InputError
+
+    try:
+        data = tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: invalid TOML ({exc})") from None
+    value = data.get("backend")
+    if value is not None and not isinstance(value, str):
+        raise InputError(f"{path}: 'backend' must be a VLM spec string")
+    return value.strip() or None if value else None
+
+
 class BackendConfig(BaseModel):
     """How to reach a VLM and how to treat its answers.
 
-    Defaults suit a real API: 8 calls in flight, 120 s per call, 6 retries with backoff
-    capped at 60 s, answers cached on disk. Tests shrink the waits to milliseconds.
+    Defaults suit a real API: 8 calls in flight, 60 s per call (10 s to connect), 6 retries
+    with backoff capped at 60 s (1 after a timeout, 2 on a dead endpoint or malformed body),
+    answers cached on disk. Tests shrink the waits to milliseconds.
     """
 
     model_config = ConfigDict(extra="forbid")
@@ -46,7 +84,11 @@ class BackendConfig(BaseModel):
     # calls in flight per backend (an asyncio.Semaphore per event loop)
     concurrency: int = Field(default=8, ge=1)
     # per-call timeout in seconds (one attempt; retries get a fresh timeout each)
-    timeout_s: float = Field(default=120.0, gt=0)
+    timeout_s: float = Field(default=60.0, gt=0)
+    # seconds to establish a connection: a dead endpoint fails in seconds, not minutes
+    connect_timeout_s: float = Field(default=10.0, gt=0)
+    # retries after a timeout (each one costs a whole timeout_s)
+    timeout_retries: int = Field(default=1, ge=0)
     # retries after the first attempt on rate limits, 5xx, timeouts and connection errors
     max_retries: int = Field(default=6, ge=0)
     # backoff: base * 2**attempt with jitter, and Retry-After, both capped at retry_max_wait_s

@@ -13,12 +13,16 @@ from typing import Any
 from rover.errors import BackendError, MissingExtraError
 from rover.vlm.base import BaseBackend, RawAnswer
 from rover.vlm.config import BackendConfig
-from rover.vlm.keys import install_log_scrubbing, read_key
-from rover.vlm.retry import ErrorInfo, ErrorKind, parse_retry_after
+from rover.vlm.endpoint import check_base_url, endpoint_identity
+from rover.vlm.keys import install_log_scrubbing, read_key, register_url_secret
+from rover.vlm.retry import ErrorInfo, ErrorKind, MalformedReply, parse_retry_after
+from rover.vlm.scrub import scrub_line
 from rover.vlm.tokens import estimate_prompt_tokens
 from rover.vlm.types import Prompt, SamplingParams, TextPart, Usage
 
 DEFAULT_KEY_ENVS = ("GEMINI_API_KEY", "GOOGLE_API_KEY")
+DEFAULT_BASE_URL = "https://generativelanguage.googleapis.com"
+UNREACHABLE_RETRIES = 2  # retries when the endpoint cannot be reached at all
 
 
 def _import_genai() -> Any:
@@ -39,6 +43,9 @@ class GeminiBackend(BaseBackend):
         _import_genai()
         install_log_scrubbing()
         self.base_url = base_url or self.config.base_url
+        if self.base_url is not None:
+            self.base_url = check_base_url(self.base_url, f"gemini:{model}")
+            register_url_secret(self.base_url)
         names = (self.config.api_key_env,) if self.config.api_key_env else DEFAULT_KEY_ENVS
         key, _ = read_key(*names)
         if key is None:
@@ -51,6 +58,9 @@ class GeminiBackend(BaseBackend):
 
     def __repr__(self) -> str:  # never show the key
         return f"<GeminiBackend {self.model}>"
+
+    def endpoint(self) -> str:
+        return endpoint_identity(self.base_url or DEFAULT_BASE_URL)
 
     def _client(self) -> Any:
         def make() -> Any:
@@ -101,8 +111,14 @@ class GeminiBackend(BaseBackend):
         response = await self._client().aio.models.generate_content(
             model=self.model, contents=contents, config=config
         )
+        if response is None or isinstance(response, str | bytes | list | dict):
+            raise MalformedReply("expected a generateContent response object")
         text = _response_text(response)
-        return RawAnswer(text=text, usage=self._usage(prompt, response))
+        try:
+            usage = self._usage(prompt, response)
+        except (TypeError, ValueError, AttributeError):  # counts that are not counts
+            usage = None
+        return RawAnswer(text=text, usage=usage)
 
     def _usage(self, prompt: Prompt, response: Any) -> Usage | None:
         meta = getattr(response, "usage_metadata", None)
@@ -130,13 +146,32 @@ class GeminiBackend(BaseBackend):
         if isinstance(exc, errors.APIError):
             return self._classify_status(exc)
         module = type(exc).__module__
+        name = type(exc).__name__
+        if "Timeout" in name:
+            return ErrorInfo(
+                ErrorKind.transient,
+                f"no answer within {self.config.timeout_s:g} s (raise it with --timeout)",
+                group="timeout",
+            )
         if isinstance(exc, OSError) or module.startswith(("httpx", "httpcore", "aiohttp")):
-            return ErrorInfo(ErrorKind.transient, f"connection problem: {type(exc).__name__}")
+            return ErrorInfo(
+                ErrorKind.transient,
+                f"cannot connect to {self.endpoint()} ({name})",
+                retry_limit=UNREACHABLE_RETRIES,
+                group="connect",
+            )
+        if module.startswith("pydantic") and name == "ValidationError":
+            return ErrorInfo(
+                ErrorKind.transient,
+                "malformed response from the server: unexpected body shape",
+                retry_limit=2,
+                group="malformed",
+            )
         return None
 
     def _classify_status(self, exc: Any) -> ErrorInfo:
         code = int(exc.code or 0)
-        detail = " ".join(str(exc.message or exc.status or "").split())[:300]
+        detail = scrub_line(str(exc.message or exc.status or ""), 300)  # scrub, then cut
         headers = getattr(getattr(exc, "response", None), "headers", None)
         retry_after = parse_retry_after(headers) or _retry_delay(exc.details)
         if code == 429:

@@ -1,25 +1,31 @@
 """API keys: read only from environment variables, and scrubbed from anything we print.
 
-Every key this process reads is remembered (in memory only) so that `scrub` can remove it
-from error messages and log records, whichever SDK produced them. Patterns for common key
-shapes are scrubbed too, for keys we never read ourselves (e.g. echoed by a proxy).
+Every key this process reads is remembered (in memory only) so that `scrub` (the one
+scrubber, in `rover.vlm.scrub`) can remove it from error messages, log records and
+anything written, whichever SDK produced them.
 """
 
 from __future__ import annotations
 
 import logging
 import os
-import re
-import threading
+from urllib.parse import unquote, urlsplit
 
-REDACTED = "<redacted>"
+# one scrubber for the whole package: these names are re-exported for existing callers
+from rover.vlm.scrub import REDACTED, register_secret, scrub, scrub_line, strip_controls
 
-_KNOWN: set[str] = set()
-_LOCK = threading.Lock()
-# OpenAI-style (sk-...), Google API keys (AIza...), bearer tokens in echoed headers
-_PATTERNS = re.compile(
-    r"(\bsk-[A-Za-z0-9_\-]{8,}|\bAIza[0-9A-Za-z_\-]{20,}|\b(?i:bearer)\s+[A-Za-z0-9._\-]{8,})"
-)
+__all__ = [
+    "REDACTED",
+    "ScrubFilter",
+    "install_log_scrubbing",
+    "read_key",
+    "register_secret",
+    "register_url_secret",
+    "scrub",
+    "scrub_line",
+    "strip_controls",
+]
+
 # loggers of the HTTP stacks the SDKs use; filters are not inherited, so name them all
 _SDK_LOGGERS = (
     "openai",
@@ -38,13 +44,6 @@ _SDK_LOGGERS = (
 )
 
 
-def register_secret(value: str) -> None:
-    """Remember a secret so `scrub` removes it; short values are ignored (too many false hits)."""
-    if value and len(value) >= 6:
-        with _LOCK:
-            _KNOWN.add(value)
-
-
 def read_key(*names: str) -> tuple[str | None, str | None]:
     """The first non-empty environment variable among `names`: (value, name) or (None, None)."""
     for name in names:
@@ -55,24 +54,28 @@ def read_key(*names: str) -> tuple[str | None, str | None]:
     return None, None
 
 
-def scrub(text: str) -> str:
-    """`text` with every known secret and key-shaped string replaced by <redacted>."""
-    with _LOCK:
-        known = sorted(_KNOWN, key=len, reverse=True)
-    for secret in known:
-        text = text.replace(secret, REDACTED)
-    return _PATTERNS.sub(REDACTED, text)
+def register_url_secret(url: str) -> None:
+    """Remember the password (or token) in a URL's userinfo, so bare mentions are scrubbed."""
+    try:
+        parts = urlsplit(url)
+        secrets = (parts.password, parts.username if parts.password is None else None)
+    except ValueError:
+        return
+    for value in secrets:
+        if value:
+            register_secret(unquote(value))
+            register_secret(value)
 
 
 class ScrubFilter(logging.Filter):
-    """Rewrites a log record's message with secrets scrubbed (never drops the record)."""
+    """Rewrites a log record's message scrubbed and without control characters (never drops it)."""
 
     def filter(self, record: logging.LogRecord) -> bool:
         try:
             message = record.getMessage()
         except Exception:  # a malformed record is the logger's problem, not ours
             return True
-        clean = scrub(message)
+        clean = strip_controls(scrub(message))  # records reach terminals too
         if clean != message:
             record.msg, record.args = clean, None
         return True

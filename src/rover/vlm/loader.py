@@ -27,12 +27,32 @@ SPEC_FORMS = (
 
 
 def split_model_url(rest: str) -> tuple[str, str | None]:
-    """`"qwen@http://host:8000/v1"` -> ("qwen", "http://host:8000/v1"); no URL -> None."""
+    """`"qwen@http://host:8000/v1"` -> ("qwen", "http://host:8000/v1"); no URL -> None.
+
+    Raises:
+        InputError: what follows an '@' looks like a server but has no scheme
+            (`m@127.0.0.1:8000/v1`): guessing would send the key to the public API.
+    """
+    lowered = rest.lower()
     for scheme in ("@http://", "@https://"):
-        at = rest.find(scheme)
+        at = lowered.find(scheme)
         if at >= 0:
             return rest[:at], rest[at + 1 :]
+    at = rest.rfind("@")
+    if at >= 0:
+        after = rest[at + 1 :]
+        if "://" in after or _looks_like_host(after):
+            raise InputError(
+                f"{rest!r}: the server after '@' needs an explicit scheme: "
+                f"{rest[:at]}@http://{after.split('://')[-1]} (or https://)"
+            )
     return rest, None
+
+
+def _looks_like_host(text: str) -> bool:
+    """'127.0.0.1:8000/v1', 'localhost', 'host.example:443': a server, not part of a name."""
+    head = text.split("/", 1)[0]
+    return bool(head) and ("/" in text or ":" in head or "." in head or head.lower() == "localhost")
 
 
 def parse_spec(spec: str) -> tuple[str, str, str | None]:

@@ -15,12 +15,16 @@ from typing import Any
 from rover.errors import BackendError
 from rover.vlm.base import BaseBackend, RawAnswer
 from rover.vlm.config import BackendConfig
-from rover.vlm.keys import install_log_scrubbing, read_key
-from rover.vlm.retry import ErrorInfo, ErrorKind, parse_retry_after
+from rover.vlm.endpoint import check_base_url, endpoint_identity
+from rover.vlm.keys import install_log_scrubbing, read_key, register_url_secret
+from rover.vlm.retry import ErrorInfo, ErrorKind, MalformedReply, parse_retry_after
+from rover.vlm.scrub import scrub_line
 from rover.vlm.tokens import estimate_prompt_tokens
 from rover.vlm.types import ImagePart, Message, Prompt, SamplingParams, TextPart, Usage
 
 DEFAULT_KEY_ENV = "OPENAI_API_KEY"
+# retries when the endpoint cannot be reached at all (refused, DNS): fail in seconds
+UNREACHABLE_RETRIES = 2
 # servers run without auth still need a non-empty key for the SDK
 PLACEHOLDER_KEY = "not-needed"
 # reasoning models take max_completion_tokens and only their default temperature
@@ -79,6 +83,9 @@ class OpenAIBackend(BaseBackend):
         install_log_scrubbing()
         # OPENAI_BASE_URL is the SDK's own override; honour it here too so the key rule matches
         self.base_url = base_url or self.config.base_url or os.environ.get("OPENAI_BASE_URL")
+        if self.base_url is not None:
+            self.base_url = check_base_url(self.base_url, f"openai:{model}")
+            register_url_secret(self.base_url)
         env = self.config.api_key_env or DEFAULT_KEY_ENV
         key, _ = read_key(env)
         if key is None:
@@ -92,21 +99,31 @@ class OpenAIBackend(BaseBackend):
         self.key_env = env
 
     def __repr__(self) -> str:  # never show the key
-        where = f" @ {self.base_url}" if self.base_url else ""
+        where = f" @ {self.where}" if self.base_url else ""
         return f"<OpenAIBackend {self.model}{where}>"
+
+    @property
+    def where(self) -> str:
+        """The server, as shown in messages (credentials removed)."""
+        return endpoint_identity(self.base_url) if self.base_url else "api.openai.com"
 
     def cache_extra(self) -> dict[str, Any]:
         return {"detail": self.config.detail}
 
+    def endpoint(self) -> str:
+        return endpoint_identity(self.base_url or "https://api.openai.com/v1")
+
     def _client(self) -> Any:
         def make() -> Any:
+            import httpx
             from openai import AsyncOpenAI
 
+            c = self.config
             return AsyncOpenAI(
                 api_key=self._key,
                 base_url=self.base_url,
                 max_retries=0,
-                timeout=self.config.timeout_s,
+                timeout=httpx.Timeout(c.timeout_s, connect=min(c.connect_timeout_s, c.timeout_s)),
             )
 
         return self.loop_local("client", make)
@@ -124,29 +141,41 @@ class OpenAIBackend(BaseBackend):
         if params.seed is not None:
             kwargs["seed"] = params.seed
         response = await self._client().chat.completions.create(**kwargs)
-        text = ""
-        if response.choices:
-            text = response.choices[0].message.content or ""
-        usage = None
-        if response.usage is not None and response.usage.prompt_tokens:
-            # the API does not break images out; the image part is the published rule's share
-            _, image_tokens = estimate_prompt_tokens(prompt, self.token_rule)
-            usage = Usage(
-                prompt_tokens=response.usage.prompt_tokens,
-                completion_tokens=response.usage.completion_tokens or 0,
-                image_tokens=min(image_tokens, response.usage.prompt_tokens),
-                source="reported",
-            )
-        return RawAnswer(text=text, usage=usage)
+        text = _reply_text(response)
+        return RawAnswer(text=text, usage=self._usage(prompt, response))
+
+    def _usage(self, prompt: Prompt, response: Any) -> Usage | None:
+        """Reported usage, or None (estimate it) when absent or not a pair of counts."""
+        reported = getattr(response, "usage", None)
+        p = getattr(reported, "prompt_tokens", None)
+        c = getattr(reported, "completion_tokens", None)
+        if not isinstance(p, int) or isinstance(p, bool) or p <= 0:
+            return None
+        # the API does not break images out; the image part is the published rule's share
+        _, image_tokens = estimate_prompt_tokens(prompt, self.token_rule)
+        return Usage(
+            prompt_tokens=p,
+            completion_tokens=c if isinstance(c, int) and c >= 0 else 0,
+            image_tokens=min(image_tokens, p),
+            source="reported",
+        )
 
     def _classify(self, exc: BaseException) -> ErrorInfo | None:
         import openai
 
         if isinstance(exc, openai.APITimeoutError):
-            return ErrorInfo(ErrorKind.transient, "request timed out")
+            return ErrorInfo(
+                ErrorKind.transient,
+                f"no answer within {self.config.timeout_s:g} s (raise it with --timeout)",
+                group="timeout",
+            )
         if isinstance(exc, openai.APIConnectionError):
-            where = self.base_url or "api.openai.com"
-            return ErrorInfo(ErrorKind.transient, f"cannot connect to {where}")
+            return ErrorInfo(
+                ErrorKind.transient,
+                f"cannot connect to {self.where}",
+                retry_limit=UNREACHABLE_RETRIES,
+                group="connect",
+            )
         if isinstance(exc, openai.APIStatusError):
             return self._classify_status(exc)
         if isinstance(exc, openai.APIResponseValidationError):
@@ -177,10 +206,9 @@ class OpenAIBackend(BaseBackend):
                 f"{detail}",
             )
         if status == 404:
-            where = self.base_url or "api.openai.com"
             return ErrorInfo(
                 ErrorKind.fatal,
-                f"not found (HTTP 404) at {where}: is the model name right? {detail}",
+                f"not found (HTTP 404) at {self.where}: is the model name right? {detail}",
             )
         return ErrorInfo(ErrorKind.fatal, f"request rejected (HTTP {status}): {detail}")
 
@@ -193,4 +221,34 @@ def _short_message(exc: Any) -> str:
         err = body.get("error", body)
         message = err.get("message") if isinstance(err, dict) else str(err)
     message = message or getattr(exc, "message", "") or type(exc).__name__
-    return " ".join(str(message).split())[:300]
+    return scrub_line(str(message), 300)  # scrubbed before the cut, never after
+
+
+def _reply_text(response: Any) -> str:
+    """The first choice's text; MalformedReply when the body is not a chat completion.
+
+    A server that answers 200 with plain text, a JSON array, `null` or a choice without a
+    message gets a bounded retry and then one line, instead of an AttributeError.
+    """
+    if isinstance(response, str | bytes | list | dict) or response is None:
+        raise MalformedReply(f"expected a chat completion object, got {_kind(response)}")
+    choices = getattr(response, "choices", None)
+    if choices is None:
+        raise MalformedReply("the body has no 'choices'")
+    if isinstance(choices, list) and not choices:
+        return ""  # a completion with no choices: an empty answer, parsed as such
+    if not isinstance(choices, list):
+        raise MalformedReply(f"'choices' is {_kind(choices)}, not a list")
+    message = getattr(choices[0], "message", None)
+    if message is None or isinstance(message, str | dict | list):
+        raise MalformedReply("the first choice has no message object")
+    content = getattr(message, "content", None)
+    if content is None:
+        return ""
+    if not isinstance(content, str):
+        raise MalformedReply(f"the message content is {_kind(content)}, not text")
+    return content
+
+
+def _kind(value: Any) -> str:
+    return "null" if value is None else type(value).__name__

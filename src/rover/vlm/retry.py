@@ -4,7 +4,10 @@ Rate limits, server errors, timeouts and dropped connections are retried with ex
 backoff and jitter (honouring a provider's Retry-After, capped), up to a bounded number of
 attempts, each under its own timeout. Anything fatal — a bad key, an unknown model, a
 malformed request — fails at once with one line (a `BackendError`), because retrying it
-only burns time and quota. Messages pass through `keys.scrub` so a key never leaks.
+only burns time and quota. Some transient failures get a smaller retry budget of their
+own: a timeout (a silent server rarely wakes up, and each try costs a full timeout), an
+unreachable endpoint, a malformed body. Messages pass through `scrub_line` (scrubbed, then
+cut to one line) so a key never leaks and a hostile body cannot reach the terminal raw.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from enum import StrEnum
 from typing import Any, TypeVar
 
 from rover.errors import BackendError
-from rover.vlm.keys import scrub
+from rover.vlm.scrub import scrub_line
 
 log = logging.getLogger(__name__)
 
@@ -40,14 +43,48 @@ class ErrorInfo:
     kind: ErrorKind
     message: str
     retry_after: float | None = None  # seconds the provider asked us to wait
+    # at most this many retries for failures of this `group` (None: the policy's max_retries)
+    retry_limit: int | None = None
+    group: str = ""
+
+
+class MalformedReply(Exception):
+    """A provider answered, but not with a body we can read (bad JSON, wrong shape, bytes).
+
+    Backends raise it from `_generate`; the retry loop treats it as transient with a small
+    budget of its own, then fails with one line.
+    """
+
+
+MALFORMED_RETRIES = 2
+
+
+def classify_common(exc: BaseException) -> ErrorInfo | None:
+    """Failures any backend can meet while reading a body: malformed, undecodable, truncated."""
+    if isinstance(exc, MalformedReply):
+        detail = str(exc)
+    elif isinstance(exc, UnicodeDecodeError):
+        detail = "body is not valid UTF-8"
+    elif isinstance(exc, ValueError) and type(exc).__name__ == "JSONDecodeError":
+        detail = f"body is not valid JSON ({exc})"
+    else:
+        return None
+    return ErrorInfo(
+        ErrorKind.transient,
+        f"malformed response from the server: {detail}",
+        retry_limit=MALFORMED_RETRIES,
+        group="malformed",
+    )
 
 
 @dataclass(frozen=True)
 class RetryPolicy:
     max_retries: int = 6
-    timeout_s: float | None = 120.0
+    timeout_s: float | None = 60.0
     base_wait_s: float = 1.0
     max_wait_s: float = 60.0
+    # retries after a timeout (each costs a whole timeout_s; a silent server stays silent)
+    timeout_retries: int = 1
 
 
 def parse_retry_after(headers: Any) -> float | None:
@@ -105,13 +142,20 @@ async def call_with_retries(
     rng = rng or random.Random()
     attempts = policy.max_retries + 1
     last = ""
+    seen: dict[str, int] = {}  # failures so far per group with its own retry budget
+    attempt = 0
     for attempt in range(attempts):
         try:
             if policy.timeout_s is None:
                 return await call()
             return await asyncio.wait_for(call(), timeout=policy.timeout_s)
         except TimeoutError:
-            info = ErrorInfo(ErrorKind.transient, f"no answer within {policy.timeout_s:g} s")
+            info = ErrorInfo(
+                ErrorKind.transient,
+                f"no answer within {policy.timeout_s:g} s (raise it with --timeout)",
+                retry_limit=policy.timeout_retries,
+                group="timeout",
+            )
         except asyncio.CancelledError:
             raise
         except Exception as exc:
@@ -119,14 +163,21 @@ async def call_with_retries(
             if verdict is None:
                 raise
             info = verdict
-        last = scrub(info.message)
+        last = scrub_line(info.message)
         if info.kind is ErrorKind.fatal:
             raise BackendError(f"{label}: {last}") from None
         if attempt + 1 >= attempts:
             break
+        limit = info.retry_limit
+        if limit is None and info.group == "timeout":  # a timeout the SDK noticed first
+            limit = policy.timeout_retries
+        if limit is not None:
+            seen[info.group] = seen.get(info.group, 0) + 1
+            if seen[info.group] > limit:
+                break
         wait = backoff_wait(attempt, policy, info.retry_after, rng)
         log.warning(
             "%s: %s; retry %d/%d in %.1f s", label, last, attempt + 1, policy.max_retries, wait
         )
         await asyncio.sleep(wait)
-    raise BackendError(f"{label}: gave up after {attempts} attempt(s): {last}")
+    raise BackendError(f"{label}: gave up after {attempt + 1} attempt(s): {last}")

@@ -39,6 +39,8 @@ class Reply:
         delay_s: sleep this long before answering (to trigger client timeouts).
         usage: (prompt, completion) tokens to report; None = a default; False = report none.
         code: provider error code (e.g. "insufficient_quota").
+        raw: send these exact bytes as the body instead (hostile or malformed replies).
+        content_type: the content-type header sent with the body.
     """
 
     status: int = 200
@@ -47,6 +49,8 @@ class Reply:
     delay_s: float = 0.0
     usage: tuple[int, int] | bool | None = None
     code: str | None = None
+    raw: bytes | None = None
+    content_type: str = "application/json"
 
 
 class _LoopbackServer:
@@ -130,10 +134,10 @@ class _LoopbackServer:
         finally:
             with self._lock:
                 self.in_flight -= 1
-        data = json.dumps(payload).encode()
+        data = reply.raw if reply.raw is not None else json.dumps(payload).encode()
         try:
             h.send_response(status)
-            h.send_header("content-type", "application/json")
+            h.send_header("content-type", reply.content_type)
             h.send_header("content-length", str(len(data)))
             for k, v in reply.headers.items():
                 h.send_header(k, v)
