@@ -11,7 +11,6 @@ import os
 import sys
 
 import typer
-from rich.console import Console
 
 from rover import __version__
 from rover.errors import RoverError
@@ -53,18 +52,50 @@ for _name in COMMANDS:
     _mod.register(app)
 
 
-def main() -> None:
-    err = Console(stderr=True, highlight=False)
+def _click_exceptions():
+    """Typer >= 0.25 vendors click as `typer._click`; older ones use click itself."""
     try:
-        app()
-    except RoverError as exc:
-        if os.environ.get("ROVER_DEBUG"):
-            raise
-        err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
+        from typer._click import exceptions
+    except ImportError:  # pragma: no cover - depends on the installed typer
+        from click import exceptions
+    return exceptions
+
+
+def main() -> None:
+    """Run the app; every failure a user can cause ends in one `error:` line, no traceback."""
+    from rover.console import make_console, print_error
+
+    click = _click_exceptions()
+
+    err = make_console(stderr=True)
+    debug = bool(os.environ.get("ROVER_DEBUG"))
+    try:
+        rc = app(standalone_mode=False)
+    except click.NoArgsIsHelpError as exc:
+        exc.show()
         sys.exit(exc.exit_code)
-    except KeyboardInterrupt:
+    except click.UsageError as exc:
+        hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+        print_error(exc.format_message() + hint, err)
+        sys.exit(exc.exit_code)
+    except click.ClickException as exc:
+        print_error(exc.format_message(), err)
+        sys.exit(exc.exit_code)
+    except RoverError as exc:
+        if debug:
+            raise
+        print_error(exc, err)
+        sys.exit(exc.exit_code)
+    except OSError as exc:  # the filesystem or network said no: a fact about the machine
+        if debug:
+            raise
+        where = f": {exc.filename}" if exc.filename else ""
+        print_error(f"{exc.strerror or type(exc).__name__}{where}", err)
+        sys.exit(2)
+    except (KeyboardInterrupt, typer.Abort):
         err.print("interrupted; rerun the same command (with --resume where offered) to continue")
         sys.exit(130)
+    sys.exit(rc if isinstance(rc, int) else 0)
 
 
 if __name__ == "__main__":
