@@ -447,3 +447,51 @@ def write_robomimic(
 def make_robomimic() -> Callable[..., Path]:
     """Fixture form of `write_robomimic`."""
     return write_robomimic
+
+
+# ---------------------------------------------------------------------------- a model's replies
+
+
+def _texts(body: dict, role: str | None = None) -> list[str]:
+    out = []
+    for m in body.get("messages", []):
+        if role is not None and m.get("role") != role:
+            continue
+        content = m.get("content")
+        if isinstance(content, str):
+            out.append(content)
+        else:
+            out += [p.get("text", "") for p in content or [] if p.get("type") == "text"]
+    return out
+
+
+def model_like_answer(body: dict) -> str:
+    """Replies to rover's prompts the way a chat model writes them: markdown, prose, no meta.
+
+    For `OpenAICompatServer.answer`: it sees only what goes over the wire (texts and
+    images), as a real server does. GVL frames get rising percentages by label; ROVER
+    decomposes the task once, then raises each subtask's percentage by 40 points from
+    the previous frame's, and says the task is complete when asked about the parent.
+    """
+    import re
+
+    system = " ".join(_texts(body, "system"))
+    user = " ".join(_texts(body, "user"))
+    if "random order" in system or "random order" in user:
+        labels = sorted({int(n) for n in re.findall(r"Frame (\d+):", user)})
+        return "\n\n".join(
+            f"**Frame {n}:**\nFrame description: The arm is over the table.\n"
+            f"Task completion percentage: {min(10 * n, 100)}%"
+            for n in labels or [1]
+        )
+    if "The robot has completed:" in system + user:
+        return "Task complete"
+    previous = re.findall(r"completion percentage: (-?\d+(?:\.\d+)?)%", user)
+    if not previous and "The robot needs to" in system and "grasp the object" not in system:
+        return "Frame description: The gripper is open.\nThe robot needs to: grasp the object"
+    p = float(previous[-1]) if previous else 0.0
+    return (
+        "Looking at the current frame, the arm has moved closer.\n\n"
+        "**Frame description:** The gripper is near the object.\n"
+        f"**Subtask completion percentage:** {min(p + 40, 100):.0f}%"
+    )

@@ -60,7 +60,7 @@ def test_frame_folder_errors(tmp_path):
     dup = tmp_path / "dup"
     dup.mkdir()
     Image.fromarray(frames_for(1, 16)[0]).save(dup / "a_1.png")
-    Image.fromarray(frames_for(1, 16)[0]).save(dup / "b_1.png")
+    Image.fromarray(frames_for(1, 16)[0]).save(dup / "a_01.png")  # same camera, same number
     with pytest.raises(InputError, match="frame number 1 also used"):
         load_episode(dup)
     sizes = tmp_path / "sizes"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -90,7 +91,9 @@ def test_reason_dataset_episode_with_oracle(tmp_path, make_episode):
     ep_dir = write_episode(tmp_path / "ds", make_episode(20, size=64))
     out = tmp_path / "gvl.json"
     res = CliRunner().invoke(
-        app, ["reason", str(ep_dir), "--method", "gvl", "--frames", "8", "--out", str(out)]
+        app,
+        ["reason", str(ep_dir), "--method", "gvl", "--frames", "8", "--backend", "oracle"]
+        + ["--out", str(out)],
     )
     assert res.exit_code == 0, res.output
     assert "ORACLE" in res.output
@@ -103,11 +106,23 @@ def test_reason_dataset_episode_with_oracle(tmp_path, make_episode):
 def test_reason_errors_are_one_line(tmp_path, clip):
     path, _ = clip
     cmd = [sys.executable, "-m", "rover.cli", "reason", str(path), "--out", str(tmp_path / "x")]
-    res = subprocess.run([*cmd, "--task", TASK], capture_output=True, text=True, timeout=120)
-    assert res.returncode == 3
-    assert "has none — use a real backend or replay" in res.stderr
+    env = {k: v for k, v in os.environ.items() if k != "ROVER_BACKEND"}
+    env["ROVER_CONFIG"] = str(tmp_path / "no-config.toml")
+
+    def run(*extra: str) -> subprocess.CompletedProcess:
+        return subprocess.run([*cmd, *extra], capture_output=True, text=True, timeout=120, env=env)
+
+    # no backend given and none configured: one line naming the choices, nothing decoded
+    res = run("--task", TASK)
+    assert res.returncode == 2 and "no VLM backend chosen" in res.stderr
+    assert "openai:<model>" in res.stderr and "ROVER_BACKEND" in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+    # the oracle on a real video: refused by the one oracle rule, one line
+    res = run("--task", TASK, "--backend", "oracle")
+    assert res.returncode == 2
+    assert "the oracle answers from simulator ground truth" in res.stderr
     assert "Traceback" not in res.stderr and len(res.stderr.strip().splitlines()) == 1
-    res = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    res = run("--backend", "oracle")
     assert res.returncode == 2 and "pass --task" in res.stderr
 
 
@@ -115,10 +130,32 @@ def test_replayed_oracle_stays_labelled(tmp_path, make_episode):
     ep_dir = write_episode(tmp_path / "ds", make_episode(10, size=64))
     cassette, out = tmp_path / "oracle.jsonl", tmp_path / "r.json"
     base = ["reason", str(ep_dir), "--method", "rover", "--out", str(out)]
-    assert CliRunner().invoke(app, [*base, "--record", str(cassette)]).exit_code == 0
+    recording = [*base, "--backend", "oracle", "--record", str(cassette)]
+    assert CliRunner().invoke(app, recording).exit_code == 0
     recorded = Trace.load(out)
     res = CliRunner().invoke(app, [*base, "--backend", f"replay:{cassette}"])
     assert res.exit_code == 0, res.output
     replayed = Trace.load(out)
     assert replayed.backend == "replay" and replayed.oracle and "ORACLE" in res.output
     assert replayed.progress() == recorded.progress()
+
+
+def test_default_backend_from_env_or_config_file_and_documented_flags(
+    tmp_path, make_episode, monkeypatch
+):
+    ep_dir = write_episode(tmp_path / "ds", make_episode(8, size=64))
+    out = tmp_path / "t.json"
+    args = ["reason", str(ep_dir), "--method", "gvl", "--out", str(out)]
+    # backends.md documents --temperature and --image-max-side for every VLM command
+    flags = ["--temperature", "0.2", "--image-max-side", "32"]
+    monkeypatch.setenv("ROVER_CONFIG", str(tmp_path / "config.toml"))
+    monkeypatch.setenv("ROVER_BACKEND", "oracle")
+    res = CliRunner().invoke(app, [*args, *flags])
+    assert res.exit_code == 0, res.output
+    assert Trace.load(out).oracle
+    monkeypatch.delenv("ROVER_BACKEND")
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code != 0 and "no VLM backend chosen" in str(res.exception)
+    (tmp_path / "config.toml").write_text('backend = "oracle"\n')
+    out.unlink()
+    assert CliRunner().invoke(app, args).exit_code == 0 and Trace.load(out).oracle

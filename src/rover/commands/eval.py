@@ -39,6 +39,12 @@ def eval_command(
             "(lerobot:PATH, rlds:PATH, hdf5:PATH, a video file, a dataset dir...)",
         ),
     ] = None,
+    task: Annotated[
+        str | None,
+        typer.Option(
+            "--task", help="With --source: task text for sources that carry none (one task)."
+        ),
+    ] = None,
     methods: Annotated[
         str, typer.Option("--methods", help="Comma-separated method names.")
     ] = "rover,gvl,temporal-concat,local-concat",
@@ -125,6 +131,7 @@ def eval_command(
     """Evaluate reasoning methods on a dataset: progress, frame reasoning, video QA, cost."""
     from rover.eval.runner import EvalOptions, finish_run, prepare_run
     from rover.eval.variants import parse_int_list, parse_name_list, split_backend_specs
+    from rover.io.source import spec_with_options
 
     if concurrency < 1:
         raise InputError(f"--concurrency must be at least 1, got {concurrency}")
@@ -150,13 +157,19 @@ def eval_command(
         raise InputError("give either --dataset or --source, not both")
     if dataset is None and source is None:
         raise InputError("give the data to evaluate: --dataset DIR or --source SPEC")
+    if task is not None and (dataset is not None or not task.strip()):
+        raise InputError(
+            "--task needs non-empty text and applies to --source only (datasets carry tasks)"
+        )
     if dataset is not None and str(dataset) == "bundled" and not dataset.exists():
         from rover.sim import bundled_dataset_path
 
         dataset = bundled_dataset_path()
     opts = EvalOptions(
         dataset=dataset,
-        sources=parse_name_list(source, "--source") if source else [],
+        sources=[spec_with_options(s, task=task) for s in parse_name_list(source, "--source")]
+        if source
+        else [],
         methods=parse_name_list(methods, "--methods"),
         backends=split_backend_specs(backend),
         judge=judge.strip(),

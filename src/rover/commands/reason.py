@@ -36,8 +36,6 @@ def _load(video: str, frames: int | None, size: int | None, task: str | None, vi
         episode = episode.model_copy(update={"task": task})
     if not episode.task.strip():
         raise InputError(f'{video} carries no task description; pass --task "..."')
-    if view:
-        episode = episode.with_view(view)
     return episode
 
 
@@ -45,7 +43,7 @@ def run_reason(
     video: str,
     *,
     method: str = "rover",
-    backend: str = "oracle",
+    backend: str | None = None,
     out: Path = Path("trace.json"),
     task: str | None = None,
     frames: int | None = None,
@@ -64,6 +62,8 @@ def run_reason(
     console = console or Console(stderr=True)
     if method not in method_names():
         raise InputError(f"unknown method {method!r}; valid methods: {', '.join(method_names())}")
+    if method not in NON_VLM_METHODS:
+        backend = vo.resolve_backend(backend)  # before any decoding: a one-line refusal
     episode = _load(video, frames, size, task, view)
     params = {"window": window, "seed": seed, "model_path": model_path}
     m = get_method(method, **params)
@@ -135,7 +135,12 @@ def register(app: typer.Typer) -> None:
         method: Annotated[
             str, typer.Option("--method", "-m", help=f"One of: {', '.join(method_names())}.")
         ] = "rover",
-        backend: Annotated[str, typer.Option("--backend", "--vlm", help=vo.VLM_HELP)] = "oracle",
+        backend: Annotated[
+            str | None,
+            typer.Option(
+                "--backend", "--vlm", help=vo.VLM_HELP + " (default: $ROVER_BACKEND / config)"
+            ),
+        ] = None,
         out: Annotated[Path, typer.Option("--out", "-o", help="Where to write the trace JSON.")] = (
             Path("trace.json")
         ),
@@ -168,6 +173,8 @@ def register(app: typer.Typer) -> None:
         api_key_env: vo.ApiKeyEnvOpt = None,
         detail: vo.DetailOpt = None,
         token_rule: vo.TokenRuleOpt = None,
+        max_side: vo.ImageMaxSideOpt = None,
+        temperature: vo.TemperatureOpt = None,
         max_tokens: vo.MaxTokensOpt = None,
         device: vo.DeviceOpt = None,
     ) -> None:
@@ -194,6 +201,8 @@ def register(app: typer.Typer) -> None:
                 "api_key_env": api_key_env,
                 "detail": detail,
                 "token_rule": token_rule,
+                "max_side": max_side,
+                "temperature": temperature,
                 "max_tokens": max_tokens,
                 "device": device,
                 "flip_prob": flip_prob,

@@ -51,23 +51,27 @@ def dataset_refs(root: Path, n: int | None, seed: int) -> list[EpisodeRef]:
 
 
 def source_refs(specs: list[str], n: int | None, seed: int) -> list[EpisodeRef]:
-    from rover.io.source import open_source
+    from rover.io.source import open_source, require_tasks
 
     refs: list[EpisodeRef] = []
+    labels: dict[str, str] = {}
     for spec in specs:
         reader = open_source(spec)
-        label = _source_label(reader.path)
+        label = reader.dataset  # the builder / dataset name, not a version folder's
+        if label in labels:
+            raise InputError(
+                f"--source: {labels[label]} and {spec} are both dataset {label!r}; "
+                "give each dataset once (their traces would overwrite each other)"
+            )
+        labels[label] = spec
         ids = reader.episode_ids()
         if not ids:
             raise InputError(f"--source {spec}: no episodes found")
+        picked = _sample(ids, n, seed)
+        require_tasks(reader, picked, where=f"--source {spec}")
         prefix = f"{label}__" if len(specs) > 1 else ""
-        refs += [EpisodeRef(prefix + i, i, label, spec) for i in _sample(ids, n, seed)]
+        refs += [EpisodeRef(prefix + i, i, label, spec) for i in picked]
     return refs
-
-
-def _source_label(path: Path) -> str:
-    name = path.name if path.name not in ("", ".") else path.resolve().name
-    return Path(name).stem or "source"
 
 
 def needed_views(variants: list[Variant]) -> list[str | None]:
@@ -118,8 +122,22 @@ def _load_from_source(ref: EpisodeRef, variants: list[Variant]) -> tuple[Episode
     counts = {v.frames for v in variants}
     frames = None if None in counts else max(c for c in counts if c)
     views = [v for v in needed_views(variants) if v]
-    reader = open_source(ref.origin, view=views[0] if len(views) == 1 else None)
+    only = views[0] if views and needed_views(variants) == views[:1] else None
+    reader = open_source(ref.origin, view=only)
     episode = reader.read(ref.source_id, frames=frames)
+    if views:
+        # sources decode one camera per read: read each view a variant asks for and keep
+        # it under the name the variant uses (a short name such as "wrist" included)
+        pixels = dict(episode.views)
+        for v in views:
+            if v not in pixels:
+                one = (
+                    episode
+                    if v == only
+                    else open_source(ref.origin, view=v).read(ref.source_id, frames=frames)
+                )
+                pixels[v] = one.views[one.view]
+        episode = episode.model_copy(update={"views": pixels})
     if episode.truth is None:
         episode = with_frame_number_truth(episode)
     episode = episode.model_copy(update={"id": ref.id, "source": episode.source or ref.origin})

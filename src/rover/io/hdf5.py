@@ -2,7 +2,8 @@
 
 Layout::
 
-    data                      attrs: env_args (JSON: env_name, env_kwargs...)
+    data                      attrs: env_args (JSON: env_name, env_kwargs...),
+                              problem_info (LIBERO JSON, has "language_instruction")
     data/demo_0               attrs: num_samples, ep_meta (RoboCasa JSON, has "lang")
     data/demo_0/obs/agentview_image        (T, H, W, 3) uint8, one per camera
     data/demo_0/obs/robot0_eef_pos ...     low-dimensional observations
@@ -55,6 +56,7 @@ class HDF5Source(SourceReader):
                 demos = [k for k in f["data"] if _DEMO.match(k)]
                 self._demos = sorted(demos, key=lambda k: int(_DEMO.match(k)[1]))
                 self._env = _json_attr(f["data"].attrs.get("env_args"))
+                self._problem = _json_attr(f["data"].attrs.get("problem_info"))
         except OSError as exc:
             raise InputError(f"{self.path}: unreadable HDF5 file ({_one_line(exc)})") from exc
         if not self._demos:
@@ -124,10 +126,21 @@ class HDF5Source(SourceReader):
         )
 
     def _task_text(self, ep_meta: dict[str, Any]) -> str:
-        lang = ep_meta.get("lang")
-        if lang:
-            return str(lang)
+        """RoboCasa: the demo's `ep_meta["lang"]`; LIBERO: `problem_info` of the file."""
+        for value in (ep_meta.get("lang"), self._problem.get("language_instruction")):
+            if isinstance(value, list | tuple):
+                value = " ".join(str(v) for v in value if v)
+            if value and str(value).strip():
+                return str(value).strip()
         return ""
+
+    def task_of(self, episode_id: str) -> str:
+        if self.task is not None:
+            return self.task
+        if episode_id not in self._demos:
+            raise InputError(f"{self.path}: no demo {episode_id!r}")
+        with _h5py().File(self.path, "r") as f:
+            return self._task_text(_json_attr(f["data"][episode_id].attrs.get("ep_meta")))
 
 
 def _json_attr(value: Any) -> dict[str, Any]:

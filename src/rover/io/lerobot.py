@@ -81,12 +81,7 @@ class LeRobotSource(SourceReader):
             raise InputError(
                 f"{self.root / INFO}: field 'features' has no camera (dtype video or image)"
             )
-        self.camera = self.view or self.cameras[0]
-        if self.camera not in self.cameras:
-            raise InputError(
-                f"{self.root / INFO}: no camera {self.camera!r} in 'features'; "
-                f"cameras: {', '.join(self.cameras)}"
-            )
+        self.camera = self._pick_camera()
         self.camera_dtype = features[self.camera]["dtype"]
         for key in ("fps", "data_path"):
             if key not in self.info:
@@ -99,6 +94,27 @@ class LeRobotSource(SourceReader):
         self._episodes = self._load_episode_table()
         self._tasks: dict[int, str] | None = None
         self._video_index: dict[Path, VideoIndex] = {}  # v3 files hold many episodes
+
+    def _pick_camera(self) -> str:
+        """The feature key for `view`: the full key, or its last dotted part (`wrist`)."""
+        if self.view is None:
+            return self.cameras[0]
+        if self.view in self.cameras:
+            return self.view
+        short = [c for c in self.cameras if c.rsplit(".", 1)[-1] == self.view]
+        if len(short) == 1:
+            return short[0]
+        shown = ", ".join(f"{c} ({c.rsplit('.', 1)[-1]})" for c in self.cameras)
+        what = "several cameras end in" if short else "no camera"
+        raise InputError(
+            f"{self.root / INFO}: {what} {self.view!r} in 'features'; cameras: {shown}"
+        )
+
+    def task_of(self, episode_id: str) -> str:
+        if self.task is not None:
+            return self.task
+        idx, row = self._row(episode_id)
+        return self._task_text(idx, row)
 
     def _index(self, video: Path) -> VideoIndex:
         if video not in self._video_index:

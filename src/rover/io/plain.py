@@ -18,6 +18,7 @@ from rover.io.video import read_video
 
 DEFAULT_FPS = 30.0
 _NUMBER = re.compile(r"\d+")
+_SEPARATORS = re.compile(r"[_\-.\s]+")
 
 
 def sample_positions(total: int, frames: int | None) -> list[int]:
@@ -38,6 +39,9 @@ class VideoFileSource(SourceReader):
             raise InputError(f"{self.path}: not a video file")
         return [self.path.stem]
 
+    def task_of(self, episode_id: str) -> str:
+        return self.task or ""
+
     def _read(self, episode_id: str, frames: int | None) -> Episode:
         index = index_video(self.path)
         total, fps = index.num_frames, index.fps
@@ -57,11 +61,26 @@ class VideoFileSource(SourceReader):
 
 
 def numbered_images(folder: Path) -> list[tuple[int, Path]]:
-    """(frame number, path) for every image in a folder, ordered by number.
+    """(frame number, path) for every image of a single-camera folder, ordered by number.
 
     The number is the last run of digits in the file name, so `frame_12.jpg` follows
     `frame_6.jpg` and gaps keep their original indices. A folder without numbers falls
-    back to name order (index = position).
+    back to name order (index = position). A folder holding several cameras by file-name
+    prefix is an error here; `camera_groups` splits those.
+    """
+    groups = camera_groups(folder)
+    if len(groups) > 1:
+        raise InputError(f"{folder}: holds several views ({', '.join(groups)}); pick one")
+    return next(iter(groups.values()))
+
+
+def camera_groups(folder: Path) -> dict[str, list[tuple[int, Path]]]:
+    """Frames of a folder grouped into views by file-name prefix, each ordered by number.
+
+    Robot logs write several cameras into one folder (`frame_wrist_0.jpg`,
+    `frame_external_0.jpg`, ...): the text around a file's last number says which camera
+    it is. Views are named by what tells their prefixes apart (`wrist`, `external`); a
+    folder with one prefix is one view named "rgb".
     """
     if not folder.is_dir():
         raise InputError(f"{folder}: not a folder")
@@ -72,33 +91,86 @@ def numbered_images(folder: Path) -> list[tuple[int, Path]]:
         raise InputError(
             f"{folder}: no frames found (expected {', '.join(sorted(IMAGE_SUFFIXES))} images)"
         )
-    numbers = [_NUMBER.findall(p.stem) for p in files]
+    numbers = [list(_NUMBER.finditer(p.stem)) for p in files]
     if not any(numbers):
-        return list(enumerate(files))
+        return {FrameFolderSource.view_name: list(enumerate(files))}
     missing = [p for p, n in zip(files, numbers, strict=True) if not n]
     if missing:
         raise InputError(f"{missing[0]}: frame file name has no frame number")
-    seen: dict[int, Path] = {}
-    for p, n in zip(files, numbers, strict=True):
-        idx = int(n[-1])
+    by_key: dict[tuple[str, str], dict[int, Path]] = {}
+    for p, found in zip(files, numbers, strict=True):
+        last = found[-1]
+        key = (p.stem[: last.start()], p.stem[last.end() :])
+        seen = by_key.setdefault(key, {})
+        idx = int(last.group())
         if idx in seen:
             raise InputError(f"{p}: frame number {idx} also used by {seen[idx].name}")
         seen[idx] = p
-    return sorted(seen.items())
+    names = _view_labels(list(by_key))
+    return {
+        names[key]: sorted(items.items())
+        for key, items in sorted(by_key.items(), key=lambda kv: names[kv[0]])
+    }
+
+
+def _view_labels(keys: list[tuple[str, str]]) -> dict[tuple[str, str], str]:
+    """Short view names: the file-name words that differ between the prefixes."""
+    if len(keys) == 1:
+        return {keys[0]: FrameFolderSource.view_name}
+    words = {k: [w for w in _SEPARATORS.split(k[0] + "_" + k[1]) if w] for k in keys}
+    lead = 0
+    while all(len(w) > lead for w in words.values()) and (
+        len({w[lead] for w in words.values()}) == 1
+    ):
+        lead += 1
+    trail = 0
+    while all(len(w) > lead + trail for w in words.values()) and (
+        len({w[-1 - trail] for w in words.values()}) == 1
+    ):
+        trail += 1
+    labels = {k: "_".join(w[lead : len(w) - trail]) for k, w in words.items()}
+    if any(not v for v in labels.values()) or len(set(labels.values())) < len(labels):
+        labels = {k: "_".join(w) or "rgb" for k, w in words.items()}
+    return labels
 
 
 class FrameFolderSource(SourceReader):
-    """A folder of images = one episode, id = folder name, index = number in file name."""
+    """A folder of images = one episode, id = folder name, index = number in file name.
+
+    Several cameras in one folder (told apart by file-name prefix) are several views;
+    `view` / `?camera=` picks one by its short name (`wrist`) or its prefix.
+    """
 
     kind = "frames"
     view_name = "rgb"
 
     def _episode_ids(self) -> list[str]:
-        numbered_images(self.path)  # validates early
+        groups = camera_groups(self.path)  # validates early
+        if len(groups) > 1:
+            self._pick(groups)
         return [self.path.resolve().name]
 
+    def task_of(self, episode_id: str) -> str:
+        return self.task or ""
+
+    def _pick(self, groups: dict[str, list[tuple[int, Path]]]) -> str:
+        names = list(groups)
+        if self.view is None:
+            return names[0]
+        if len(names) == 1:
+            return names[0]
+        wanted = self.view.strip("_-. ").lower()
+        for name, items in groups.items():
+            stem = items[0][1].stem
+            prefix = stem[: list(_NUMBER.finditer(stem))[-1].start()].strip("_-. ")
+            if wanted in (name.lower(), prefix.lower()):
+                return name
+        raise InputError(f"{self.path}: no view {self.view!r}; views found: {', '.join(names)}")
+
     def _read(self, episode_id: str, frames: int | None) -> Episode:
-        items = numbered_images(self.path)
+        groups = camera_groups(self.path)
+        chosen_view = self._pick(groups)
+        items = groups[chosen_view]
         positions = sample_positions(len(items), frames)
         chosen = [items[p] for p in positions]
         arrays = [_load_image(path) for _, path in chosen]
@@ -109,14 +181,19 @@ class FrameFolderSource(SourceReader):
                     f"{path}: frame size {arr.shape[1]}x{arr.shape[0]} differs from "
                     f"{shape[1]}x{shape[0]} of {chosen[0][1].name}"
                 )
-        name = self.view or self.view_name
+        if len(groups) == 1:
+            name = self.view or self.view_name
+            names = [name]
+        else:
+            name, names = chosen_view, list(groups)
         return Episode(
             id=episode_id,
             task=self.task or "",
             source=str(self.path),
             fps=self.fps or DEFAULT_FPS,
             frame_indices=[idx for idx, _ in chosen],
-            view_names=[name],
+            view_names=names,
+            default_view=name,
             views={name: np.stack(arrays)},
             extra={"index_range": [items[0][0], items[-1][0]], "total_frames": len(items)},
         )
@@ -147,6 +224,15 @@ class DatasetDirSource(SourceReader):
 
     def _episode_ids(self) -> list[str]:
         return [self._single] if self._single else episode_ids(self.root)
+
+    @property
+    def dataset(self) -> str:
+        return read_dataset_info(self.root).name
+
+    def task_of(self, episode_id: str) -> str:
+        if self.task is not None:
+            return self.task
+        return read_episode(self.root, episode_id, load_frames=False).task
 
     def _read(self, episode_id: str, frames: int | None) -> Episode:
         meta = read_episode(self.root, episode_id, load_frames=False)

@@ -100,6 +100,10 @@ class RLDSSource(SourceReader):
         self.dataset_name = self._dataset_name()
         self._spans: dict[Path, list[RecordSpan]] = {}
 
+    @property
+    def dataset(self) -> str:
+        return self.dataset_name
+
     def _load_schema(self) -> dict[str, str] | None:
         path = self.folder / "features.json"
         if not path.exists():

@@ -102,6 +102,27 @@ class SourceReader(ABC):
         """Short human-readable name of the source (used in reports and episode.source)."""
         return f"{self.kind}:{self.path}"
 
+    @property
+    def dataset(self) -> str:
+        """Name of the dataset this source holds, for per-dataset tables and run ids.
+
+        Readers whose folders carry a builder or dataset name (RLDS `dataset_info.json`,
+        a version folder's parent) override this; the default is the file stem or folder
+        name.
+        """
+        path = self.path if self.path.name not in ("", ".") else self.path.resolve()
+        return (path.stem if path.is_file() else path.name) or "source"
+
+    def task_of(self, episode_id: str) -> str:
+        """The task text an episode will carry, read as cheaply as the format allows.
+
+        Used to refuse a run before any VLM call when episodes have no task. The
+        default reads one frame; readers that keep tasks in metadata override it.
+        """
+        if self.task is not None:
+            return self.task
+        return self._read(episode_id, 1).task
+
     def episode_ids(self) -> list[str]:
         """Ids of the episodes this source holds, in a stable order."""
         ids = self._episode_ids()
@@ -290,6 +311,30 @@ def sample_episode_ids(reader: SourceReader, n: int | None, seed: int) -> list[s
     rng = np.random.default_rng(seed)
     picked = sorted(int(i) for i in rng.choice(len(ids), size=n, replace=False))
     return [ids[i] for i in picked]
+
+
+def require_tasks(reader: SourceReader, ids: list[str], where: str = "") -> None:
+    """Refuse (one line) when an episode has no task text: every VLM call would ask about
+    "the subtask of ." and be wasted. Checked before any call is made."""
+    for episode_id in ids:
+        if not reader.task_of(episode_id).strip():
+            raise InputError(
+                f"{where or reader.path}: episode {episode_id!r} carries no task description; "
+                'pass --task "..." (or ?task=... in the spec)'
+            )
+
+
+def spec_with_options(spec: str, **options: str | None) -> str:
+    """`spec` with query options added (`?task=...`), URL-quoted so any text survives."""
+    from urllib.parse import urlencode
+
+    extra = {k: v for k, v in options.items() if v is not None}
+    if not extra:
+        return spec
+    kind, path, params = parse_spec(spec)
+    params.update(extra)
+    head = f"{kind}:" if kind else ""
+    return f"{head}{path}?{urlencode(params)}"
 
 
 def _reader_class(kind: str) -> type[SourceReader]:

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rover.errors import BackendError
+from rover.errors import BackendError, InputError
 from rover.vlm.base import BaseBackend, RawAnswer
 from rover.vlm.config import BackendConfig
 from rover.vlm.types import Prompt, PromptMeta, SamplingParams
@@ -120,6 +120,23 @@ def _fmt(p: float) -> str:
     return str(int(round(p)))
 
 
+def require_simulator_truth(episode: Episode) -> None:
+    """The one rule for the oracle on real data: it answers only from simulator truth.
+
+    Every method and `rover eval` bind the oracle to an episode before asking it anything,
+    so refusing here covers `rover reason`, `rover eval` and `rover annotate` alike. Real
+    videos carry no truth, or App. L's frame-number stand-in, which the oracle would echo
+    back as a perfect score.
+    """
+    truth = episode.truth
+    if truth is None or truth.progress_source != "simulation":
+        what = "no ground truth" if truth is None else f"{truth.progress_source} progress only"
+        raise InputError(
+            f"the oracle answers from simulator ground truth; episode {episode.id!r} has "
+            f"{what}: use a real backend (openai:, gemini:, hf:) or replay:"
+        )
+
+
 class OracleBackend(BaseBackend):
     """Unbound oracle: `bind(episode)` gives the instance that actually answers."""
 
@@ -147,6 +164,7 @@ class BoundOracle(OracleBackend):
 
     def __init__(self, episode: Episode, config: BackendConfig | None = None) -> None:
         super().__init__(config)
+        require_simulator_truth(episode)
         self.episode = episode
         self._descriptions: dict[int, str] = {}  # deterministic per frame: compute once
 
