@@ -102,6 +102,27 @@ DeviceOpt = Annotated[
     str | None, typer.Option("--device", help="hf backend device: cpu, cuda, cuda:1 ...")
 ]
 
+
+def resolve_backend(given: str | None) -> str:
+    """The backend spec a command uses: `--backend`, else `ROVER_BACKEND` or the config file.
+
+    Raises:
+        InputError: none of them is set (one line naming the choices).
+    """
+    from rover.vlm.config import BACKEND_ENV, config_file_path, default_backend
+
+    if given is not None and given.strip():
+        return given.strip()
+    chosen = default_backend()
+    if chosen:
+        return chosen
+    raise InputError(
+        "no VLM backend chosen: pass --backend SPEC ("
+        + VLM_HELP.removeprefix("VLM spec: ")
+        + f"), or set {BACKEND_ENV} or 'backend = \"SPEC\"' in {config_file_path()}"
+    )
+
+
 # option name -> BackendConfig field, where they differ
 _RENAMES = {
     "cache": "cache_path",
