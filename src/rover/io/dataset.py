@@ -9,6 +9,10 @@ Layout (schema version 1)::
 An episode folder appears under its final name only once complete (written as
 `<id>.part` then renamed), so a killed writer never leaves a half episode that a
 reader would mistake for a finished one; resuming simply redoes `.part` folders.
+
+Episode ids and view names are names, never paths: each is checked (`rover.paths`) and
+every file is resolved inside the dataset root, so a hostile `episode.json` cannot make
+rover read (and send to a VLM) a video from elsewhere on the disk.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from rover import __version__
 from rover.episode import SCHEMA_VERSION, Episode
 from rover.errors import InputError
 from rover.io.video import read_video, write_video
+from rover.paths import check_name, inside
 
 DATASET_FILE = "dataset.json"
 EPISODE_FILE = "episode.json"
@@ -49,9 +54,13 @@ def read_dataset_info(root: Path) -> DatasetInfo:
     if not path.exists():
         raise InputError(f"{root}: not a rover dataset directory (no {DATASET_FILE})")
     try:
-        info = DatasetInfo.model_validate_json(path.read_text())
+        info = DatasetInfo.model_validate_json(path.read_bytes())
     except ValidationError as exc:
         raise InputError(f"{path}: invalid dataset file ({_first_error(exc)})") from exc
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read ({exc.strerror or exc})") from exc
+    for name in info.views:
+        check_name(name, f"{path}: view name")
     if info.schema_version > SCHEMA_VERSION:
         raise InputError(
             f"{path}: schema version {info.schema_version} is newer than this rover "
@@ -74,6 +83,9 @@ def episode_ids(root: Path) -> list[str]:
 
 def write_episode(root: Path, episode: Episode, fps: float | None = None) -> Path:
     """Write one episode (metadata + one MP4 per loaded view) atomically."""
+    check_name(episode.id, "episode id")
+    for name in [*episode.view_names, *episode.views]:
+        check_name(name, f"episode {episode.id!r}: view name")
     ep_root = Path(root) / "episodes"
     final = ep_root / episode.id
     tmp = ep_root / (episode.id + ".part")
@@ -93,17 +105,24 @@ def read_episode(
     root: Path, episode_id: str, views: list[str] | None = None, load_frames: bool = True
 ) -> Episode:
     """Load one episode; `views=None` loads every view, `load_frames=False` none."""
+    check_name(episode_id, "episode id")
     folder = Path(root) / "episodes" / episode_id
     meta_path = folder / EPISODE_FILE
     if not meta_path.exists():
         raise InputError(f"{folder}: no {EPISODE_FILE} (unknown or unfinished episode)")
+    meta_path = inside(root, "episodes", episode_id, EPISODE_FILE, what="episode file")
     try:
-        raw = json.loads(meta_path.read_text())
+        raw = json.loads(meta_path.read_text(encoding="utf-8"))
+        if not isinstance(raw, dict):
+            raise ValueError("not a JSON object")
         raw.pop("views", None)
         episode = Episode.model_validate(raw)
-    except (ValidationError, json.JSONDecodeError) as exc:
-        detail = _first_error(exc) if isinstance(exc, ValidationError) else str(exc)
+    except (ValidationError, ValueError) as exc:  # JSON and UTF-8 errors are ValueErrors
+        detail = _first_error(exc) if isinstance(exc, ValidationError) else str(exc)[:200]
         raise InputError(f"{meta_path}: invalid episode file ({detail})") from exc
+    check_name(episode.id, f"{meta_path}: episode id")
+    for name in episode.view_names:
+        check_name(name, f"{meta_path}: view name")
     if not load_frames:
         return episode
     wanted = episode.view_names if views is None else views
@@ -112,7 +131,10 @@ def read_episode(
             raise InputError(
                 f"episode {episode_id!r} has no view {v!r}; views: {', '.join(episode.view_names)}"
             )
-    loaded = {v: read_video(folder / f"{v}.mp4") for v in wanted}
+    loaded = {
+        v: read_video(inside(root, "episodes", episode_id, f"{v}.mp4", what="video"))
+        for v in wanted
+    }
     for v, arr in loaded.items():
         if len(arr) != episode.num_frames:
             raise InputError(
