@@ -19,11 +19,16 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from rover.console import esc, make_console
+from rover.console import line as safe_line
 from rover.errors import InputError
 from rover.methods.base import StepInfo
 from rover.methods.registry import NON_VLM_METHODS, get_method, method_names
 from rover.methods.trace import Trace
+from rover.paths import check_output_file
 from rover.vlm import cli_options as vo
+
+MIN_SIZE, MAX_SIZE = 16, 8192  # --size bounds (px, long side)
 
 
 def _load(video: str, frames: int | None, size: int | None, task: str | None, view: str | None):
@@ -31,7 +36,13 @@ def _load(video: str, frames: int | None, size: int | None, task: str | None, vi
 
     if frames is not None and frames <= 0:
         raise InputError(f"--frames must be positive, got {frames}")
+    if size is not None and not MIN_SIZE <= size <= MAX_SIZE:
+        raise InputError(f"--size must be between {MIN_SIZE} and {MAX_SIZE} px, got {size}")
     episode = load_episode(video, frames=frames, size=size, task=task, view=view)
+    if frames is not None and episode.num_frames < frames:
+        raise InputError(
+            f"--frames {frames}: {safe_line(video)} has only {episode.num_frames} frames"
+        )
     if task:
         episode = episode.model_copy(update={"task": task})
     if not episode.task.strip():
@@ -59,9 +70,10 @@ def run_reason(
     """Everything `rover reason` does, callable from Python (and from tests)."""
     from rover.vlm.loader import load_vlm
 
-    console = console or Console(stderr=True)
+    console = console or make_console(stderr=True)
     if method not in method_names():
         raise InputError(f"unknown method {method!r}; valid methods: {', '.join(method_names())}")
+    out = check_output_file(out)  # before any decoding or paid call
     if method not in NON_VLM_METHODS:
         backend = vo.resolve_backend(backend)  # before any decoding: a one-line refusal
     episode = _load(video, frames, size, task, view)
@@ -77,8 +89,8 @@ def run_reason(
         TextColumn("[bold]{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
-        TextColumn("{task.fields[path]}"),
-        TextColumn("{task.fields[last]}"),
+        TextColumn("{task.fields[path]}", markup=False),  # model text: never markup
+        TextColumn("{task.fields[last]}", markup=False),
         TimeElapsedColumn(),
         console=console,
         transient=True,
@@ -91,13 +103,13 @@ def run_reason(
             bar.update(
                 job,
                 completed=min(info.position + 1, n),
-                path=path[-60:],
+                path=safe_line(path)[-60:],
                 last=f"{last}  calls {info.calls}",
             )
 
         trace = asyncio.run(_run(m, episode, vlm, on_step))
     trace.save(out)
-    _summary(summary or Console(highlight=False), trace, out)
+    _summary(summary or make_console(), trace, out)
     return trace
 
 
@@ -115,14 +127,14 @@ def _summary(console: Console, trace: Trace, out: Path) -> None:
     final = trace.progress()[-1] if trace.frames else 0.0
     label = " [bold yellow]ORACLE[/] (answers from ground truth, not a VLM)" if trace.oracle else ""
     console.print(
-        f"[bold]{trace.method}[/] on {trace.episode_id}: {trace.num_frames} frames, "
+        f"[bold]{esc(trace.method)}[/] on {esc(trace.episode_id)}: {trace.num_frames} frames, "
         f"{t.calls} calls ({t.cached_calls} cached), {t.total_tokens:,} tokens "
         f"({t.prompt_tokens:,} prompt + {t.completion_tokens:,} completion), "
         f"{t.parse_failures} parse failures, final progress {final:.0f}%{label}",
         highlight=False,
         soft_wrap=True,
     )
-    console.print(f"trace written to {out}", highlight=False, soft_wrap=True)
+    console.print(f"trace written to {esc(out)}", highlight=False, soft_wrap=True)
 
 
 def register(app: typer.Typer) -> None:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from rover.errors import BackendError, InputError
 from rover.vlm.base import BaseBackend, RawAnswer
 from rover.vlm.config import BackendConfig
+from rover.vlm.scrub import scrub
 from rover.vlm.tokens import estimate_usage
 from rover.vlm.types import Completion, Prompt, SamplingParams, Usage
 
@@ -58,7 +59,7 @@ class CassetteWriter:
             "frames": prompt.meta.frame_indices,
             "backend": completion.backend,
             "model": completion.model,
-            "text": completion.text,
+            "text": scrub(completion.text),  # cassettes are shared: no echoed key in them
             "usage": completion.usage.model_dump(),
             "latency_s": completion.latency_s,
         }
@@ -127,14 +128,25 @@ class ReplayBackend(BaseBackend):
     def _read(self) -> None:
         if not self.path.is_file():
             raise InputError(f"replay: no cassette at {self.path}")
-        lines = self.path.read_text(encoding="utf-8").splitlines()
+        try:
+            lines = self.path.read_text(encoding="utf-8").splitlines()
+        except UnicodeDecodeError as exc:
+            raise InputError(
+                f"replay: {self.path} is not a UTF-8 text cassette (byte {exc.start})"
+            ) from None
+        except OSError as exc:
+            raise InputError(f"replay: cannot read {self.path}: {exc.strerror or exc}") from None
         for number, line in enumerate(lines, 1):
             if not line.strip():
                 continue
             try:
                 entry = json.loads(line)
-                key, prompt, _ = entry["key"], entry["prompt"], entry["text"]
-            except (json.JSONDecodeError, KeyError, TypeError) as exc:
+                key, prompt, text = entry["key"], entry["prompt"], entry["text"]
+                if not all(isinstance(x, str) for x in (key, prompt, text)):
+                    raise TypeError("key, prompt and text must be strings")
+                if entry.get("usage") is not None:
+                    Usage.model_validate(entry["usage"])
+            except (ValueError, KeyError, TypeError) as exc:  # pydantic errors are ValueErrors
                 if number == len(lines):  # a recording cut off mid-line: drop only that line
                     break
                 raise InputError(f"replay: {self.path} line {number} is malformed") from exc
