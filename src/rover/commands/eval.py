@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
+from rover.console import esc, make_console
 from rover.errors import InputError
 from rover.vlm import cli_options as vo
 
@@ -135,6 +136,8 @@ def eval_command(
 
     if concurrency < 1:
         raise InputError(f"--concurrency must be at least 1, got {concurrency}")
+    if calls_in_flight is not None and calls_in_flight < 1:  # 0 is not "unset"
+        raise InputError(f"--calls-in-flight must be at least 1, got {calls_in_flight}")
     config = vo.config_from_options(
         cache=cache,
         no_cache=no_cache,
@@ -148,7 +151,7 @@ def eval_command(
         temperature=temperature,
         max_tokens=max_tokens,
         device=device,
-        concurrency=calls_in_flight or concurrency,
+        concurrency=concurrency if calls_in_flight is None else calls_in_flight,
         flip_prob=flip_prob,
         jitter=jitter,
         seed=oracle_seed,
@@ -254,8 +257,8 @@ def _print_main_table(metrics: dict, oracle: bool = False) -> None:
             justify="left" if is_name else "right",
         )
     for r in rows:
-        table.add_row(*r)
-    Console().print(table)
+        table.add_row(*(esc(cell) for cell in r))  # method and backend names are data
+    make_console().print(table)
 
 
 def _build_report(run_dir: Path, err: Console) -> None:
