@@ -8,10 +8,13 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
+from rover.console import esc, make_console
 from rover.errors import InputError
+from rover.paths import check_output_dir
+
+MAX_SIZE = 1024  # px: the offscreen framebuffer grows with the square of the size
 
 
 def _split(value: str) -> list[str]:
@@ -50,6 +53,11 @@ def generate_command(
     check_views(view_list)
     if per_level < 1 or size < 16 or workers < 1 or demos < 1:
         raise InputError("--per-level, --workers and --demos must be >= 1, --size >= 16")
+    if size > MAX_SIZE:
+        raise InputError(f"--size must be at most {MAX_SIZE} px, got {size}")
+    if frames < 0:
+        raise InputError(f"--frames must be 0 (the task's default) or positive, got {frames}")
+    _check_levels(task_list, _split(levels))
     if source_hdf5 is not None and not source_hdf5.exists():
         raise InputError(f"--source-hdf5 {source_hdf5}: no such file")
     cfg = GenerateConfig(
@@ -63,8 +71,10 @@ def generate_command(
         demos=demos,
         source_hdf5=str(source_hdf5) if source_hdf5 else None,
     )
+    check_output_dir(out, "--out", marker="dataset.json")
+    _check_resume(out, cfg)
     logging.getLogger("robosuite").setLevel(logging.ERROR)
-    console = Console(stderr=True)
+    console = make_console(stderr=True)
     start = time.perf_counter()
     with Progress(
         TextColumn("{task.description}"),
@@ -84,7 +94,44 @@ def generate_command(
 
         written = generate(cfg, out, workers=workers, on_progress=on_progress)
     took = time.perf_counter() - start
-    console.print(f"wrote {len(written)} episodes to {out} in {took:.1f}s")
+    console.print(f"wrote {len(written)} episodes to {esc(out)} in {took:.1f}s")
+
+
+# settings that change what an episode looks like: a dataset never mixes two values
+_EPISODE_SETTINGS = ("frames", "views", "size", "seed", "demos", "source_hdf5", "progress_form")
+
+
+def _check_levels(tasks: list[str], wanted: list[str]) -> None:
+    """Every level number asked for exists in every task (`--levels 99` is not `last`)."""
+    from rover.sim.tasks import get_task
+
+    for w in wanted:
+        if not w.isdigit():
+            continue
+        for t in tasks:
+            have = sorted(lv.level for lv in get_task(t).levels)
+            if int(w) not in have:
+                raise InputError(
+                    f"--levels {w}: task {t} has levels {', '.join(map(str, have))} "
+                    "(or use 'last' / 'all')"
+                )
+
+
+def _check_resume(out: Path, cfg) -> None:
+    """Refuse to add episodes to a dataset made with other settings (one line naming them)."""
+    from rover.io.dataset import DATASET_FILE, read_dataset_info
+
+    if not (out / DATASET_FILE).exists():
+        return
+    before = read_dataset_info(out).generator
+    now = cfg.model_dump(mode="json")
+    differ = [k for k in _EPISODE_SETTINGS if k in before and before.get(k) != now.get(k)]
+    if differ:
+        said = ", ".join(f"--{k.replace('_', '-')} {before[k]!r} (now {now[k]!r})" for k in differ)
+        raise InputError(
+            f"{out} was generated with other settings: {said}; "
+            "use a new --out or the same settings to resume"
+        )
 
 
 def register(app: typer.Typer) -> None:
