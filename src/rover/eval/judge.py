@@ -145,30 +145,49 @@ def rule_judge_trace(trace: Trace, episode: Episode, variant: str) -> Judgements
     )
 
 
+JUDGE_PARAMS = SamplingParams(temperature=0.0, max_tokens=400)
+
+
+async def llm_judge_frame(
+    vlm: VLM,
+    task: str,
+    description: str,
+    facts: FrameFacts,
+    index: int = 0,
+    position: int = 0,
+) -> tuple[FrameJudgement, int]:
+    """One App. C.2 judge call: (parsed judgement, tokens used).
+
+    The call goes through the backend like a method's call, so it is cached, retried and
+    recorded the same way; `index`/`position` only label the prompt for tracing.
+    """
+    meta = PromptMeta(
+        kind="judge.frame",
+        frame_indices=[index],
+        positions=[position],
+        extra={"description": description, "facts": facts.model_dump(mode="json")},
+    )
+    prompt = build_prompt(
+        "judge", meta, task=task, description=description, facts=facts_to_text(facts)
+    )
+    completion = await vlm.complete(prompt, JUDGE_PARAMS)
+    return parse_judge_reply(completion.text), completion.usage.total_tokens
+
+
 async def llm_judge_trace(
     trace: Trace, episode: Episode, variant: str, vlm: VLM, judge_name: str
 ) -> Judgements:
     """Judge every described frame of a trace with an LLM (one call per frame)."""
-    params = SamplingParams(temperature=0.0, max_tokens=400)
     usage = {"calls": 0, "tokens": 0}
 
     async def one(index: int, pos: int, desc: str | None, facts: FrameFacts | None):
         if not desc or facts is None:
             why = "no description" if not desc else "no simulator facts for this frame"
             return FrameVerdictRecord(index=index, position=pos, verdict="inconclusive", reason=why)
-        meta = PromptMeta(
-            kind="judge.frame",
-            frame_indices=[index],
-            positions=[pos],
-            extra={"description": desc, "facts": facts.model_dump(mode="json")},
-        )
-        prompt = build_prompt(
-            "judge", meta, task=episode.task, description=desc, facts=facts_to_text(facts)
-        )
-        completion = await vlm.complete(prompt, params)
+        judgement, tokens = await llm_judge_frame(vlm, episode.task, desc, facts, index, pos)
         usage["calls"] += 1
-        usage["tokens"] += completion.usage.total_tokens
-        return _record(index, pos, parse_judge_reply(completion.text))
+        usage["tokens"] += tokens
+        return _record(index, pos, judgement)
 
     verdicts = await asyncio.gather(*(one(*f) for f in _frames(trace, episode)))
     return Judgements(

@@ -117,28 +117,42 @@ def parse_qa_reply(text: str, num_frames: int) -> tuple[bool | None, int | None]
     return yes, pos
 
 
+QA_PARAMS = SamplingParams(temperature=0.0, max_tokens=100)
+
+
+async def llm_answer_question(
+    vlm: VLM, task: str, context: str, item: QAItem, num_frames: int
+) -> tuple[bool | None, int | None, str, int]:
+    """One App. C.3 call: (yes/no, 0-based frame, reply text, tokens used).
+
+    `context` is the concatenated "Frame i: ..." descriptions; the call is cached and
+    retried by the backend like any method call.
+    """
+    meta = PromptMeta(
+        kind="qa.answer",
+        extra={"question": item.question, "event": item.event, "object": item.object},
+    )
+    prompt = build_prompt("qa", meta, task=task, descriptions=context, question=item.question)
+    completion = await vlm.complete(prompt, QA_PARAMS)
+    yes, pos = parse_qa_reply(completion.text, num_frames)
+    return yes, pos, completion.text, completion.usage.total_tokens
+
+
 async def llm_answer_trace(
     trace: Trace, episode: Episode, variant: str, vlm: VLM, answerer: str
 ) -> QAAnswers:
     """Answer each question with one LLM call over all descriptions."""
     qa = episode.truth.qa if episode.truth is not None else []
     context = concatenated(descriptions_by_position(trace, episode))
-    params = SamplingParams(temperature=0.0, max_tokens=100)
     usage = {"calls": 0, "tokens": 0}
 
     async def one(item: QAItem) -> QAAnswer:
-        meta = PromptMeta(
-            kind="qa.answer",
-            extra={"question": item.question, "event": item.event, "object": item.object},
+        yes, pos, text, tokens = await llm_answer_question(
+            vlm, episode.task, context, item, episode.num_frames
         )
-        prompt = build_prompt(
-            "qa", meta, task=episode.task, descriptions=context, question=item.question
-        )
-        completion = await vlm.complete(prompt, params)
         usage["calls"] += 1
-        usage["tokens"] += completion.usage.total_tokens
-        yes, pos = parse_qa_reply(completion.text, episode.num_frames)
-        return _answer(item, episode, yes, pos, completion.text.strip()[:300])
+        usage["tokens"] += tokens
+        return _answer(item, episode, yes, pos, text.strip()[:300])
 
     answers = await asyncio.gather(*(one(q) for q in qa))
     return QAAnswers(

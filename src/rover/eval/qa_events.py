@@ -39,7 +39,7 @@ class Asserted:
     pressed: dict[str, bool] = field(default_factory=dict)
 
 
-def asserted_states(descriptions: list[str | None]) -> list[Asserted]:
+def asserted_states(descriptions: list[str | None], task: str | None = None) -> list[Asserted]:
     """One `Asserted` per frame position."""
     out = []
     for d in descriptions:

@@ -46,8 +46,10 @@ def frame_verdict(n_true: int, n_false: int) -> Verdict:
     return "true" if n_true else "inconclusive"
 
 
-def judge_description(description: str | None, facts: FrameFacts | None) -> FrameJudgement:
-    """Judge one description against one frame's facts."""
+def judge_description(
+    description: str | None, facts: FrameFacts | None, task: str | None = None
+) -> FrameJudgement:
+    """Judge one description against one frame's facts (`task` names "the target bin")."""
     if facts is None:
         return FrameJudgement("inconclusive", reason="no simulator facts for this frame")
     if not description:
