@@ -115,7 +115,7 @@ def test_error_table_shares_of_videos() -> None:
         for p in (1, 0, 0, 1)
     ]
     table = {r["error_type"]: r for r in error_table(rows)}
-    assert table["perception"]["mean"] == 0.5 and table["total"]["mean"] == 0.5
+    assert table["perception"]["mean"] == 50.0 and table["total"]["mean"] == 50.0  # % of videos
     assert table["incorrect_subtask"]["mean"] is None  # NA, as in the paper for GVL
 
 

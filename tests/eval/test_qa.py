@@ -25,9 +25,11 @@ def test_qa_scores_hand_computed() -> None:
         _a(True, None, 3),  # unreadable: wrong, counts as "no"
     ]
     s = qa_scores(answers)
-    assert s["accuracy"] == pytest.approx(3 / 6)
-    assert s["precision"] == pytest.approx(2 / 3)
-    assert s["recall"] == pytest.approx(2 / 4)
+    # percentages; the unreadable answer is wrong, never dropped
+    assert s["accuracy"] == pytest.approx(100 * 3 / 6)
+    assert s["precision"] == pytest.approx(100 * 2 / 3)
+    assert s["recall"] == pytest.approx(100 * 2 / 4)
+    assert s["unreadable"] == 1
     assert s["signed_distance"] == pytest.approx((-3 + 1) / 2)
     assert s["abs_distance"] == pytest.approx((3 + 1) / 2)
     assert s["distance_n"] == 2

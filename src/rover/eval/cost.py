@@ -27,7 +27,16 @@ def cost_row(trace: Trace) -> dict[str, Any]:
         "cached_calls": t.cached_calls,
         "parse_failures": t.parse_failures,
         "latency_s": t.latency_s,
+        "truncated": truncated_replies(t),
     }
+
+
+def truncated_replies(t: Totals) -> int | None:
+    """Replies cut off at max_tokens, when the method records them (else None)."""
+    for name in ("truncated", "truncations", "truncated_replies", "truncated_calls"):
+        if name in type(t).model_fields:
+            return int(getattr(t, name) or 0)
+    return None
 
 
 def cost_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:

@@ -95,7 +95,9 @@ def video_errors(trace: Trace, episode: Episode, judgements: Judgements | None) 
     bad = {v.index for v in judgements.verdicts if v.verdict == "false"} if judgements else set()
     if judgements is not None and judgements.has_facts:
         out["perception"] = int(bool(bad))
-    if episode.truth is not None:
+    # frame-number truth (real videos) rises every frame, so any predicted drop would
+    # "contradict" it: the reasoning rule only applies to measured progress
+    if episode.truth is not None and episode.truth.progress_source != "frame_number":
         a = align(trace, episode)
         flag = 0
         for i in range(1, len(a.indices)):
@@ -157,7 +159,7 @@ def _subtask_errors(trace: Trace, episode: Episode) -> dict[str, int]:
 
 
 def error_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Share of videos (mean ± SE of the 0/1 flags) with each error type, per variant."""
+    """Percentage of videos (mean ± SE of the 0/1 flags) with each error type, per variant."""
     out = []
     variants = sorted({r["variant"] for r in rows})
     for v in variants:
@@ -172,7 +174,7 @@ def error_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
             for i in range(len(vr))
         ]
         for k, vals in list(flags.items()) + [("total", total)]:
-            mean, se, n = mean_se([x for x in vals if x is not None])
+            mean, se, n = mean_se([100.0 * x for x in vals if x is not None])  # % of videos
             out.append(
                 {
                     "variant": v,

@@ -12,16 +12,15 @@ time for questions both say happened (negative = the method claims it too early)
 from __future__ import annotations
 
 import asyncio
-import math
 import re
 
 from pydantic import BaseModel, Field
 
 from rover.episode import Episode, QAItem
-from rover.eval.aggregate import mean_se
 from rover.eval.prompts import build_prompt
 from rover.eval.qa_events import asserted_states, first_event_position
 from rover.methods.trace import Trace
+from rover.run.scorer import qa_scores  # noqa: F401 - scoring lives in the one scorer
 from rover.vlm.types import VLM, PromptMeta, SamplingParams
 
 
@@ -163,42 +162,3 @@ async def llm_answer_trace(
         calls=usage["calls"],
         total_tokens=usage["tokens"],
     )
-
-
-def qa_scores(answers: list[QAAnswer]) -> dict[str, float]:
-    """Accuracy, precision, recall and temporal distances over a set of answers.
-
-    An unreadable answer (predicted None) counts as wrong for accuracy and as "no" for
-    precision/recall. Distances are over true positives that carry both frames.
-    """
-    n = len(answers)
-    if n == 0:
-        return {
-            "qa_n": 0,
-            "accuracy": math.nan,
-            "precision": math.nan,
-            "recall": math.nan,
-            "signed_distance": math.nan,
-            "abs_distance": math.nan,
-            "distance_n": 0,
-        }
-    correct = sum(a.predicted is not None and a.predicted == a.truth for a in answers)
-    tp = sum(bool(a.predicted) and a.truth for a in answers)
-    fp = sum(bool(a.predicted) and not a.truth for a in answers)
-    fn = sum(not a.predicted and a.truth for a in answers)
-    dists = [
-        a.predicted_frame - a.truth_frame
-        for a in answers
-        if a.predicted and a.truth and a.predicted_frame is not None and a.truth_frame is not None
-    ]
-    signed, _, k = mean_se(dists)
-    absolute, _, _ = mean_se([abs(d) for d in dists])
-    return {
-        "qa_n": n,
-        "accuracy": correct / n,
-        "precision": tp / (tp + fp) if tp + fp else math.nan,
-        "recall": tp / (tp + fn) if tp + fn else math.nan,
-        "signed_distance": signed,
-        "abs_distance": absolute,
-        "distance_n": k,
-    }

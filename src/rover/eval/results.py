@@ -23,7 +23,7 @@ from rover.eval.progress_metrics import (
     frame_subset_pearson,
     score_progress,
 )
-from rover.eval.qa import QAAnswer, QAAnswers, qa_scores
+from rover.eval.qa import QAAnswer, QAAnswers
 from rover.eval.rundir import METRICS_FILE, SUMMARY_FILE, RunDir, write_json_atomic
 from rover.eval.stratify import (
     FRAME_STRATA,
@@ -35,8 +35,11 @@ from rover.eval.stratify import (
 )
 from rover.eval.variants import Variant
 from rover.methods.trace import Trace
+from rover.run import SCHEMA_VERSION
+from rover.run.scorer import qa_scores, signed_distances
 
-METRICS_SCHEMA = 1
+METRICS_SCHEMA = SCHEMA_VERSION
+# rates (error, success, QA accuracy / precision / recall) are percentages, 0-100
 TRACE_METRICS = (
     "pearson",
     "l2",
@@ -44,7 +47,12 @@ TRACE_METRICS = (
     "frame_corr",
     "error_rate",
     "success_rate",
+    "inconclusive_rate",
     "qa_accuracy",
+    "qa_precision",
+    "qa_recall",
+    "qa_signed_dt",
+    "qa_abs_dt",
     "total_tokens",
     "calls",
 )
@@ -57,7 +65,12 @@ TABLE_OF = {
     "abs_error": "progress",
     "error_rate": "reasoning",
     "success_rate": "reasoning",
+    "inconclusive_rate": "reasoning",
     "qa_accuracy": "qa",
+    "qa_precision": "qa",
+    "qa_recall": "qa",
+    "qa_signed_dt": "qa",
+    "qa_abs_dt": "qa",
     "total_tokens": "cost",
     "calls": "cost",
 }
@@ -74,8 +87,14 @@ _SCORE_KEYS = (
     "error_rate",
     "success_rate",
     "n_judged",
+    "inconclusive_rate",
     "qa_accuracy",
+    "qa_precision",
+    "qa_recall",
+    "qa_signed_dt",
+    "qa_abs_dt",
     "qa_n",
+    "qa_unreadable",
     "stage_error",
 )
 
@@ -147,10 +166,23 @@ def compute_metrics(rundir: RunDir, config: dict[str, Any]) -> dict[str, Any]:
                 frame_rows += _frame_rows(row, trace, ep, judg)
             if judg is not None:
                 err, ok, n = judg.rates()
-                row.update(error_rate=err, success_rate=ok, n_judged=n)
+                row.update(
+                    error_rate=100.0 * err,
+                    success_rate=100.0 * ok,
+                    n_judged=n,
+                    inconclusive_rate=100.0 - 100.0 * (err + ok),
+                )
             if qa is not None:
                 sc = qa_scores(qa.answers)
-                row.update(qa_accuracy=sc["accuracy"], qa_n=sc["qa_n"])
+                row.update(
+                    qa_accuracy=sc["accuracy"],
+                    qa_precision=sc["precision"],
+                    qa_recall=sc["recall"],
+                    qa_signed_dt=sc["signed_distance"],
+                    qa_abs_dt=sc["abs_distance"],
+                    qa_n=sc["qa_n"],
+                    qa_unreadable=sc["unreadable"],
+                )
                 answers.setdefault(v.id, []).extend((row, a) for a in qa.answers)
             for k, flag in video_errors(trace, ep, judg).items():
                 row[f"err_{k}"] = flag
@@ -168,7 +200,77 @@ def compute_metrics(rundir: RunDir, config: dict[str, Any]) -> dict[str, Any]:
         "cost": cost_table([r for r in rows if r.get("error") is None]),
         "error_analysis": error_table([r for r in rows if r.get("error") is None]),
         "counts": _counts(rows),
+        "notes": _notes(rows, frame_rows),
+        "judges": judge_facts(config),
     }
+    return out
+
+
+INCONCLUSIVE_WARN = 30.0  # % of a method's judged frames
+
+
+def _notes(rows: list[dict[str, Any]], frame_rows: list[dict[str, Any]]) -> list[str]:
+    """One line per analysis that does not apply to this run, saying why (never zeros)."""
+    ok = [r for r in rows if r.get("error") is None]
+    notes = []
+    judged = [r for r in ok if r.get("n_judged") is not None]
+    if ok and not any(r.get("error_rate") is not None for r in ok):
+        if judged or any(r.get("n_judged") == 0 for r in ok):
+            notes.append(
+                "Frame reasoning (Task 2, error / success rate, error rate by state type and "
+                "frames in context) is omitted: no video in this run has simulator facts to "
+                "judge descriptions against."
+            )
+    frame_truth = [r for r in ok if r.get("progress_source") == "frame_number"]
+    if frame_truth:
+        notes.append(
+            f"{len({r['episode_id'] for r in frame_truth})} video(s) have no measured progress: "
+            "their ground truth is the frame number (App. L), so Pearson r and L2 there "
+            "measure agreement with steady progress, and the derived reasoning-error rule "
+            "(a predicted drop against rising truth) is not applied to them."
+        )
+    if ok and not any(r["by"] == "state_type" for r in frame_rows):
+        notes.append("By state type (App. H): omitted, no video carries state-type labels.")
+    if ok and not any(r.get("qa_n") for r in ok):
+        notes.append("Video QA (Task 3): omitted, no video in this run carries QA questions.")
+    return notes
+
+
+def judge_facts(config: dict[str, Any]) -> dict[str, Any]:
+    """Which judge and answerer scored the run, with their measured agreement if known."""
+    out: dict[str, Any] = {"judge": config.get("judge"), "answerer": config.get("answerer")}
+    try:
+        from rover.eval import judge_cards  # written by the judge work; optional
+    except ImportError:
+        return out
+    for role in ("judge", "answerer"):
+        name = out[role]
+        card = None
+        for fn in ("agreement", "card", "judge_card", f"{role}_card"):
+            f = getattr(judge_cards, fn, None)
+            if callable(f):
+                try:
+                    card = f(name)
+                except Exception:  # noqa: BLE001 - the card is extra information only
+                    card = None
+                if card is not None:
+                    break
+        if card is not None:
+            out[f"{role}_agreement"] = card if isinstance(card, int | float | str) else str(card)
+    return out
+
+
+def inconclusive_warnings(metrics: dict[str, Any]) -> dict[str, float]:
+    """Variant id -> mean inconclusive share (%) where it exceeds INCONCLUSIVE_WARN."""
+    out = {}
+    for a in metrics.get("aggregates", []):
+        if (
+            a["metric"] == "inconclusive_rate"
+            and a["by"] == "all"
+            and a["mean"] is not None
+            and a["mean"] > INCONCLUSIVE_WARN
+        ):
+            out[a["variant"]] = a["mean"]
     return out
 
 
@@ -179,7 +281,8 @@ def _frame_rows(
     a = align(trace, ep)
     st = state_types(ep)
     ctx = context_frames(trace)
-    verdict = {v.index: v.verdict for v in judg.verdicts} if judg else {}
+    # without simulator facts every verdict is inconclusive: no rate, not a rate of 0
+    verdict = {v.index: v.verdict for v in judg.verdicts} if judg and judg.has_facts else {}
     labels = {
         "state_type": [st.get(i) for i in a.indices],
         "context": [context_bin(ctx.get(i)) for i in a.indices],
@@ -199,11 +302,15 @@ def _frame_rows(
                     "n": sum(keep),
                     "pearson": frame_subset_pearson(a, keep),
                     "abs_error": frame_subset_abs_error(a, keep),
-                    "error_rate": (sum(x == "false" for x in vs) / len(vs)) if vs else math.nan,
-                    "success_rate": (sum(x == "true" for x in vs) / len(vs)) if vs else math.nan,
+                    "error_rate": _pct(vs, "false"),
+                    "success_rate": _pct(vs, "true"),
                 }
             )
     return out
+
+
+def _pct(verdicts: list[str], which: str) -> float:
+    return 100.0 * sum(x == which for x in verdicts) / len(verdicts) if verdicts else math.nan
 
 
 def _aggregates(rows, frame_rows, variants: list[Variant], multi_dataset: bool):
@@ -262,14 +369,7 @@ def _qa_pooled(answers, variants: list[Variant]) -> list[dict[str, Any]]:
                     "by": "all" if g == "all" else by,
                     "group": "all" if g == "all" else group,
                     **{k: finite_or_none(x) if isinstance(x, float) else x for k, x in sc.items()},
-                    "signed_distances": [
-                        a.predicted_frame - a.truth_frame
-                        for a in items
-                        if a.predicted
-                        and a.truth
-                        and a.predicted_frame is not None
-                        and a.truth_frame is not None
-                    ],
+                    "signed_distances": signed_distances(items),
                 }
             )
     return out

@@ -7,19 +7,30 @@ from typing import Any
 from rover.eval.aggregate import fmt_mean_se
 
 MAIN_COLUMNS = [
-    # (header, source, metric, digits)
+    # (header, source, metric, digits); every column is a per-video mean ± SE, and
+    # rates are percentages (0-100) everywhere: here, the terminal and the HTML report
     ("Pearson r", "agg", "pearson", 2),
     ("L2", "agg", "l2", 1),
     ("VOC", "agg", "voc", 2),
     ("Corr. frame #", "agg", "frame_corr", 2),
-    ("Error rate", "agg", "error_rate", 2),
-    ("Success rate", "agg", "success_rate", 2),
-    ("QA acc.", "qa", "accuracy", 2),
-    ("QA prec.", "qa", "precision", 2),
-    ("QA recall", "qa", "recall", 2),
-    ("QA |Δt|", "qa", "abs_distance", 1),
+    ("Error rate %", "agg", "error_rate", 1),
+    ("Success rate %", "agg", "success_rate", 1),
+    ("QA acc. %", "agg", "qa_accuracy", 1),
+    ("QA prec. %", "agg", "qa_precision", 1),
+    ("QA recall %", "agg", "qa_recall", 1),
+    ("QA Δt", "agg", "qa_signed_dt", 1),
+    ("QA |Δt|", "agg", "qa_abs_dt", 1),
     ("Tokens/video", "agg", "total_tokens", 0),
     ("Calls/video", "agg", "calls", 1),
+]
+POOLED_COLUMNS = [  # (header, qa_pooled key, digits): over all questions of a variant
+    ("Questions", "qa_n", 0),
+    ("Unreadable", "unreadable", 0),
+    ("QA acc. %", "accuracy", 1),
+    ("QA prec. %", "precision", 1),
+    ("QA recall %", "recall", 1),
+    ("QA Δt", "signed_distance", 1),
+    ("QA |Δt|", "abs_distance", 1),
 ]
 METRIC_NAMES = {
     "pearson": "Pearson r",
@@ -53,9 +64,9 @@ COMPACT = (
     "Pearson r",
     "L2",
     "VOC",
-    "Error rate",
-    "Success rate",
-    "QA acc.",
+    "Error rate %",
+    "Success rate %",
+    "QA acc. %",
     "Tokens/video",
     "Calls/video",
 )
@@ -64,27 +75,45 @@ COMPACT = (
 def main_rows(metrics: dict[str, Any], compact: bool = False) -> tuple[list[str], list[list[str]]]:
     """(headers, rows) of the main table: one row per variant (compact: for terminals)."""
     idx = _agg_index(metrics)
-    qa = {(q["variant"]): q for q in metrics.get("qa_pooled", []) if q["by"] == "all"}
     columns = [c for c in MAIN_COLUMNS if not compact or c[0] in COMPACT]
+    # a column no variant has a number for (no judge, no QA, real videos) is left out
+    columns = [
+        c
+        for c in columns
+        if any(
+            (a := idx.get((v["id"], c[2], "all", "all"))) is not None and a["mean"] is not None
+            for v in metrics.get("variants", [])
+        )
+    ]
     headers = ["Method"] + [c[0] for c in columns] + ["n"]
     rows = []
     for v in metrics.get("variants", []):
         cells = [v["label"] or v["id"]]
         n = 0
-        for _, src, metric, digits in columns:
-            if src == "agg":
-                a = idx.get((v["id"], metric, "all", "all"))
-                if a is None:
-                    cells.append("–")
-                    continue
-                n = max(n, a["n"])
-                cells.append(_fmt(a["mean"], None if compact else a["se"], digits))
-            else:
-                q = qa.get(v["id"])
-                cells.append(_fmt(q.get(metric) if q else None, None, digits))
+        for _, _src, metric, digits in columns:
+            a = idx.get((v["id"], metric, "all", "all"))
+            if a is None:
+                cells.append("–")
+                continue
+            n = max(n, a["n"])
+            cells.append(_fmt(a["mean"], None if compact else a["se"], digits))
         cells.append(str(n))
         rows.append(cells)
     return headers, rows
+
+
+def pooled_rows(metrics: dict[str, Any]) -> tuple[list[str], list[list[str]]] | None:
+    """Secondary QA table: every question of a variant pooled (no SE); None without QA."""
+    rows = [q for q in metrics.get("qa_pooled", []) if q["by"] == "all" and q.get("qa_n")]
+    if not rows:
+        return None
+    labels = {v["id"]: v["label"] or v["id"] for v in metrics.get("variants", [])}
+    body = [
+        [labels.get(q["variant"], q["variant"])]
+        + [_fmt(q.get(k), None, d) if d else str(q.get(k) or 0) for _, k, d in POOLED_COLUMNS]
+        for q in rows
+    ]
+    return ["Method"] + [c[0] for c in POOLED_COLUMNS], body
 
 
 def _fmt(mean: Any, se: Any, digits: int) -> str:
@@ -100,8 +129,8 @@ def pivot(
 ) -> tuple[list[str], list[list[str]]] | None:
     """Rows = groups of `by`, columns = variants; None when the run has no such groups."""
     aggs = [a for a in metrics.get("aggregates", []) if a["by"] == by and a["metric"] == metric]
-    if not aggs:
-        return None
+    if not any(a["mean"] is not None for a in aggs):
+        return None  # nothing measured: omitted (metrics.json notes say why), never zeros
     variants = [
         v for v in metrics.get("variants", []) if any(a["variant"] == v["id"] for a in aggs)
     ]
@@ -120,9 +149,9 @@ def pivot(
 
 
 SWEEPS = [  # (variant field, title, metrics)
-    ("frames", "App. H: by frames per video", ("pearson", "error_rate")),
-    ("view", "App. I: by camera view", ("pearson", "error_rate")),
-    ("backend", "App. J: by backbone VLM", ("pearson", "l2", "error_rate", "success_rate")),
+    ("frames", "App. I: by frames per video", ("pearson", "error_rate")),
+    ("view", "App. J: by camera view", ("pearson", "error_rate")),
+    ("backend", "App. K: by backbone VLM", ("pearson", "l2", "error_rate", "success_rate")),
     ("window", "App. M: by sliding-window size", ("pearson", "error_rate")),
 ]
 _SHORT = {"backend": "b", "frames": "f", "window": "w", "view": "v"}
@@ -181,7 +210,8 @@ def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
         f"- data: `{src}`  ",
         f"- episodes: {len(run.get('episodes', []))}  ",
         f"- backends: {', '.join(run.get('backends', []))}  ",
-        f"- judge: {run.get('judge')}, QA answerer: {run.get('answerer')}",
+        f"- judge: {_judge_line(metrics, run, 'judge')}, "
+        f"QA answerer: {_judge_line(metrics, run, 'answerer')}",
         "",
     ]
     if any(b == "oracle" for b in run.get("backends", [])):
@@ -195,26 +225,47 @@ def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
         "",
         markdown_table(*main_rows(metrics)),
         "",
+        "Rates are percentages. QA columns are per-video means (the paper's and its "
+        "reference code's aggregation); Δt is predicted minus true frame (negative: too "
+        "early), |Δt| its size, over correctly answered 'yes' questions.",
+        "",
     ]
+    from rover.eval.results import inconclusive_warnings
+
+    labels = {v["id"]: v["label"] or v["id"] for v in metrics.get("variants", [])}
+    for vid, share in inconclusive_warnings(metrics).items():
+        out.append(
+            f"- **{labels.get(vid, vid)}: the judge left {share:.0f}% of its frames "
+            "inconclusive**, so its error rate rests on fewer than 70% of its frames."
+        )
+    if inconclusive_warnings(metrics):
+        out.append("")
+    pooled = pooled_rows(metrics)
+    if pooled is not None:
+        out += ["## Video QA pooled over questions (secondary)", "", markdown_table(*pooled), ""]
+    notes = metrics.get("notes", [])
+    if notes:
+        out += ["## Not applicable to this run", ""] + [f"- {n}" for n in notes] + [""]
     sections = [
         ("Task 1: Pearson r by task group (Fig. 3)", "pearson", "task_group", 2),
-        ("Task 1: Pearson r by level", "pearson", "level", 2),
-        ("Task 1: L2 distance by level (App. A.1)", "l2", "level", 1),
+        ("Task 1: Pearson r by level (Fig. 3)", "pearson", "level", 2),
+        ("Task 1: L2 distance by level (App. A)", "l2", "level", 1),
         (
-            "Task 1: correlation with frame number by non-expert share (App. A.1)",
+            "Task 1: correlation with frame number by non-expert share (App. A)",
             "frame_corr",
             "nonexpert",
             2,
         ),
-        ("Task 2: error rate by level (Fig. 4)", "error_rate", "level", 2),
-        ("Task 2: success rate by level (App. A.2)", "success_rate", "level", 2),
-        ("Task 2: error rate by task group", "error_rate", "task_group", 2),
-        ("App. G: Pearson r by state type", "pearson", "state_type", 2),
-        ("App. G: Pearson r by frames in context", "pearson", "context", 2),
-        ("App. G: error rate by state type", "error_rate", "state_type", 2),
-        ("App. G: error rate by frames in context", "error_rate", "context", 2),
+        ("Task 2: error rate % by level (Fig. 5)", "error_rate", "level", 1),
+        ("Task 2: success rate % by level (App. A)", "success_rate", "level", 1),
+        ("Task 2: error rate % by task group", "error_rate", "task_group", 1),
+        ("App. H: Pearson r by state type", "pearson", "state_type", 2),
+        ("App. H: Pearson r by frames in context", "pearson", "context", 2),
+        ("App. H: error rate % by state type", "error_rate", "state_type", 1),
+        ("App. H: error rate % by frames in context", "error_rate", "context", 1),
         ("App. L: VOC by dataset", "voc", "dataset", 3),
-        ("App. L: Pearson r (vs frame number) by dataset", "pearson", "dataset", 3),
+        ("App. L: correlation with frame number by dataset", "frame_corr", "dataset", 3),
+        ("App. L: Pearson r with ground truth by dataset", "pearson", "dataset", 3),
     ]
     for title, metric, by, digits in sections:
         t = pivot(metrics, metric, by, digits)
@@ -254,7 +305,7 @@ def _cost_section(metrics: dict[str, Any]) -> list[str]:
             ]
         )
     headers = ["Method", "Frames", "Avg tokens per video", "Avg VLM calls per video", "n"]
-    return ["## Inference cost (App. G)", "", markdown_table(headers, body), ""]
+    return ["## Inference cost (App. F)", "", markdown_table(headers, body), ""]
 
 
 def _error_section(metrics: dict[str, Any]) -> list[str]:
@@ -276,16 +327,24 @@ def _error_section(metrics: dict[str, Any]) -> list[str]:
         line = [name]
         for v in variants:
             r = cell.get((v, k))
-            line.append("NA" if not r or r["mean"] is None else f"{100 * r['mean']:.0f}%")
+            line.append("NA" if not r or r["mean"] is None else f"{r['mean']:.0f}%")
         body.append(line)
     return [
-        "## Error analysis: share of videos with each error type (App. D, derived)",
+        "## Error analysis: share of videos with each error type "
+        "(Sec. 5 Table 1, types in App. C.4; derived)",
         "",
         markdown_table(["Error type"] + [labels.get(v, v) for v in variants], body),
         "",
         "Derivation rules: docs/evaluation.md#error-analysis.",
         "",
     ]
+
+
+def _judge_line(metrics: dict[str, Any], run: dict[str, Any], role: str) -> str:
+    facts = metrics.get("judges", {})
+    name = facts.get(role) or run.get(role)
+    agree = facts.get(f"{role}_agreement")
+    return f"{name} (measured agreement: {agree})" if agree is not None else str(name)
 
 
 def _counts_section(metrics: dict[str, Any]) -> list[str]:

@@ -15,9 +15,10 @@ from typing import Any
 from pydantic import BaseModel, Field
 
 from rover.errors import InputError
+from rover.methods.info import WINDOW_METHODS, method_info
 
-# methods whose behaviour depends on the sliding-window size (App. M)
-WINDOW_METHODS = frozenset({"rover", "rover-no-recursion"})
+# methods whose behaviour depends on the sliding-window size (App. M) and their default
+# come from the method registry (rover.methods.info)
 DEFAULT_WINDOW = 3
 _SLUG_MAX = 40
 
@@ -78,7 +79,7 @@ def expand_variants(
     out: list[Variant] = []
     seen: set[str] = set()
     for method, backend, n, w, view in product(methods, backends, frames, windows, views):
-        window = (w or DEFAULT_WINDOW) if method in WINDOW_METHODS else None
+        window = (w or method_info(method).default_window) if method in WINDOW_METHODS else None
         vid = variant_id(method, backend, n, window, view)
         if vid in seen:
             continue

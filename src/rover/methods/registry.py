@@ -7,6 +7,10 @@ from typing import Any
 
 from rover.errors import InputError
 from rover.methods.base import Method
+from rover.methods.info import NON_VLM_METHODS as _NON_VLM
+from rover.methods.info import MethodInfo, method_info
+
+__all__ = ["NON_VLM_METHODS", "MethodInfo", "get_method", "method_info", "method_names"]
 
 
 def _factories() -> dict[str, Callable[..., Method]]:
@@ -35,7 +39,7 @@ def method_names() -> list[str]:
 
 
 # methods that only look at pixels through an embedding model: no VLM calls, no tokens
-NON_VLM_METHODS = frozenset({"clip-value"})
+NON_VLM_METHODS = _NON_VLM
 
 
 def get_method(name: str, **params: Any) -> Method:
