@@ -33,6 +33,8 @@ class RawAnswer:
 
     text: str
     usage: Usage | None = None  # None: the provider reported nothing, estimate it
+    finish_reason: str | None = None  # the provider's stop reason, as it wrote it
+    truncated: bool = False  # stopped at max_tokens ("length", "MAX_TOKENS")
 
 
 class BaseBackend:
@@ -128,6 +130,8 @@ class BaseBackend:
             cached=False,
             backend=self.backend,
             model=self.model,
+            finish_reason=raw.finish_reason,
+            truncated=raw.truncated,
         )
         if cache is not None:
             cache.put(key, completion)

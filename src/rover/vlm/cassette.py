@@ -62,6 +62,8 @@ class CassetteWriter:
             "text": scrub(completion.text),  # cassettes are shared: no echoed key in them
             "usage": completion.usage.model_dump(),
             "latency_s": completion.latency_s,
+            "finish_reason": completion.finish_reason,
+            "truncated": completion.truncated,
         }
         line = json.dumps(entry, ensure_ascii=False) + "\n"
         with self._lock, self.path.open("a", encoding="utf-8") as f:
@@ -186,4 +188,6 @@ class ReplayBackend(BaseBackend):
             cached=False,
             backend=self.backend,
             model=entry.get("model") or self.model,
+            finish_reason=entry.get("finish_reason"),
+            truncated=bool(entry.get("truncated", False)),
         )

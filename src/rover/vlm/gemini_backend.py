@@ -118,7 +118,10 @@ class GeminiBackend(BaseBackend):
             usage = self._usage(prompt, response)
         except (TypeError, ValueError, AttributeError):  # counts that are not counts
             usage = None
-        return RawAnswer(text=text, usage=usage)
+        finish = _finish_reason(response)
+        return RawAnswer(
+            text=text, usage=usage, finish_reason=finish, truncated=finish == "MAX_TOKENS"
+        )
 
     def _usage(self, prompt: Prompt, response: Any) -> Usage | None:
         meta = getattr(response, "usage_metadata", None)
@@ -192,6 +195,15 @@ class GeminiBackend(BaseBackend):
                 ErrorKind.fatal, f"not found (HTTP 404): is the model name right? {detail}"
             )
         return ErrorInfo(ErrorKind.fatal, f"request rejected (HTTP {code}): {detail}")
+
+
+def _finish_reason(response: Any) -> str | None:
+    """The first candidate's finish reason by name ("STOP", "MAX_TOKENS"), if any."""
+    for candidate in (getattr(response, "candidates", None) or [])[:1]:
+        reason = getattr(candidate, "finish_reason", None)
+        if reason is not None:
+            return str(getattr(reason, "name", None) or getattr(reason, "value", reason))
+    return None
 
 
 def _response_text(response: Any) -> str:

@@ -194,7 +194,15 @@ class HFBackend(BaseBackend):
                 image_tokens=int((prompt_ids == image_id).sum()) if image_id is not None else 0,
                 source="reported",
             )
-        return RawAnswer(text=text, usage=usage)
+        # stopped for length: no end-of-sequence token within the max_new_tokens generated
+        ids = generated.tolist()
+        truncated = _generated_length(generated, tokenizer) == len(ids) >= params.max_tokens
+        return RawAnswer(
+            text=text,
+            usage=usage,
+            finish_reason="length" if truncated else "stop",
+            truncated=truncated,
+        )
 
 
 def _generated_length(generated: Any, tokenizer: Any) -> int:

@@ -142,7 +142,13 @@ class OpenAIBackend(BaseBackend):
             kwargs["seed"] = params.seed
         response = await self._client().chat.completions.create(**kwargs)
         text = _reply_text(response)
-        return RawAnswer(text=text, usage=self._usage(prompt, response))
+        finish = _finish_reason(response)
+        return RawAnswer(
+            text=text,
+            usage=self._usage(prompt, response),
+            finish_reason=finish,
+            truncated=finish == "length",
+        )
 
     def _usage(self, prompt: Prompt, response: Any) -> Usage | None:
         """Reported usage, or None (estimate it) when absent or not a pair of counts."""
@@ -252,3 +258,12 @@ def _reply_text(response: Any) -> str:
 
 def _kind(value: Any) -> str:
     return "null" if value is None else type(value).__name__
+
+
+def _finish_reason(response: Any) -> str | None:
+    """The first choice's finish reason ("stop", "length"), if the body gives a string."""
+    choices = getattr(response, "choices", None)
+    if not isinstance(choices, list) or not choices:
+        return None
+    reason = getattr(choices[0], "finish_reason", None)
+    return reason if isinstance(reason, str) else None

@@ -208,6 +208,9 @@ class Completion(BaseModel):
     cached: bool = False
     backend: str = ""
     model: str = ""
+    # why generation stopped, as the provider said ("stop", "length", Gemini "MAX_TOKENS")
+    finish_reason: str | None = None
+    truncated: bool = False  # the reply stopped at the completion budget (max_tokens)
 
 
 @runtime_checkable
