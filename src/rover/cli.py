@@ -24,7 +24,7 @@ app = typer.Typer(
 )
 
 # command name -> module under rover.commands exposing `register(app)`
-COMMANDS = ["reason", "generate", "eval", "report", "demo"]
+COMMANDS = ["reason", "generate", "eval", "report", "demo", "annotate", "export"]
 
 
 def _version(value: bool) -> None:

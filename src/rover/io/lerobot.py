@@ -110,6 +110,15 @@ class LeRobotSource(SourceReader):
             f"{self.root / INFO}: {what} {self.view!r} in 'features'; cameras: {shown}"
         )
 
+    def global_offsets(self) -> dict[int, int]:
+        """episode_index -> dataset-wide index of its first frame (LeRobot's `index`)."""
+        offsets, running = {}, 0
+        for idx, row in self._episodes.items():
+            start = row.get("dataset_from_index")
+            offsets[idx] = int(start) if start is not None else running
+            running = offsets[idx] + int(row.get("length") or 0)
+        return offsets
+
     def task_of(self, episode_id: str) -> str:
         if self.task is not None:
             return self.task
