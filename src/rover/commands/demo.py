@@ -20,7 +20,9 @@ from rich import box
 from rich.console import Console
 from rich.table import Table
 
+from rover.console import esc, make_console
 from rover.errors import InputError, MissingExtraError
+from rover.paths import check_output_dir
 
 # every method that talks to a VLM (clip-value needs local embedding weights)
 DEMO_METHODS = [
@@ -36,6 +38,7 @@ DEMO_METHODS = [
 FLIP_PROB = 0.1
 JITTER = 5.0
 GENERATE_TASKS = ["Lift", "Door"]
+DEMO_ENTRIES = {"dataset", "run", "report"}  # what a demo folder holds (reruns reuse it)
 ORACLE_LINE = "ORACLE OUTPUT — answers come from simulator ground truth, not a VLM"
 
 
@@ -63,16 +66,19 @@ def demo(
     ] = None,
 ) -> None:
     """Run every VLM method on a small dataset with the oracle backend, then build the report."""
-    console = Console(highlight=False)
+    console = make_console()
     started = time.monotonic()
     out = Path(out)
     chosen = _methods(methods)
+    # before any work: a folder of somebody else's is never written into
+    reused = out.is_dir() and {p.name for p in out.iterdir()} <= DEMO_ENTRIES
+    check_output_dir(out, "--out", allow_nonempty=reused)
     console.print(f"[bold red]{ORACLE_LINE}[/]")
     console.print(
         f"oracle noise: claims flipped with p={FLIP_PROB}, progress jitter ±{JITTER:g} points"
     )
     dataset = _generate(out / "dataset", console) if generate else _bundled()
-    console.print(f"dataset: {dataset}")
+    console.print(f"dataset: {esc(dataset)}")
     run_dir = out / "run"
     metrics = _evaluate(dataset, run_dir, chosen, limit, console)
     from rover.report import build_report
@@ -82,10 +88,10 @@ def demo(
     console.print(_table(run_dir))
     failed = (metrics.get("counts") or {}).get("failed") or 0
     if failed:
-        console.print(f"[yellow]{failed} work units failed; see {run_dir / 'errors.jsonl'}[/]")
+        console.print(f"[yellow]{failed} work units failed; see {esc(run_dir / 'errors.jsonl')}[/]")
     console.print(f"done in {time.monotonic() - started:.0f} s")
-    console.print(f"report: {index}", soft_wrap=True)
-    console.print(f"open it: {index.resolve().as_uri()}", soft_wrap=True)
+    console.print(f"report: {esc(index)}", soft_wrap=True)
+    console.print(f"open it: {esc(index.resolve().as_uri())}", soft_wrap=True)
 
 
 def _methods(text: str | None) -> list[str]:
@@ -178,7 +184,7 @@ def _table(run_dir: Path) -> Table:
             return "—" if n == 0 else f"{m:,.{digits}f}"
 
         table.add_row(
-            v,
+            esc(v),
             cell("pearson", 2),
             cell("l2", 0),
             cell("error_rate", 1),

@@ -6,7 +6,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
+
+from rover.console import esc, make_console
+from rover.errors import InputError
+from rover.paths import check_output_dir
 
 
 def register(app: typer.Typer) -> None:
@@ -30,8 +33,12 @@ def report(
     """Draw the paper's figures (PNG + SVG) and write one HTML page with an episode viewer."""
     from rover.report import build_report
 
-    console = Console(highlight=False)
+    if not run_dir.is_dir():
+        raise InputError(f"{run_dir}: no such run directory (write one with rover eval --out)")
+    if out is not None:  # before drawing anything: never into somebody else's folder
+        check_output_dir(out, "--out", marker="index.html")
+    console = make_console()
     with console.status("building report"):
         index = build_report(run_dir, out, dataset=dataset, max_episodes=max_episodes)
-    console.print(f"report: {index}", soft_wrap=True)
-    console.print(f"open it: {index.resolve().as_uri()}", soft_wrap=True)
+    console.print(f"report: {esc(index)}", soft_wrap=True)
+    console.print(f"open it: {esc(index.resolve().as_uri())}", soft_wrap=True)
