@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Any
 
 from rover.eval.aggregate import fmt_mean_se
@@ -202,6 +203,91 @@ def markdown_table(headers: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
+@dataclass
+class Table:
+    """One titled table of a run; summary.md and the HTML report render the same list."""
+
+    id: str
+    title: str
+    headers: list[str]
+    rows: list[list[str]]
+    note: str = ""
+    warnings: list[str] = field(default_factory=list)
+
+
+MAIN_NOTE = (
+    "Rates are percentages. QA columns are per-video means (the paper's and its "
+    "reference code's aggregation); Δt is predicted minus true frame (negative: too "
+    "early), |Δt| its size, over correctly answered 'yes' questions."
+)
+PIVOTS = [  # (id, title, metric, by, digits)
+    ("pearson-group", "Task 1: Pearson r by task group (Fig. 3)", "pearson", "task_group", 2),
+    ("pearson-level", "Task 1: Pearson r by level (Fig. 3)", "pearson", "level", 2),
+    ("l2-level", "Task 1: L2 distance by level (App. A)", "l2", "level", 1),
+    (
+        "framecorr-nonexpert",
+        "Task 1: correlation with frame number by non-expert share (App. A)",
+        "frame_corr",
+        "nonexpert",
+        2,
+    ),
+    ("error-level", "Task 2: error rate % by level (Fig. 5)", "error_rate", "level", 1),
+    ("success-level", "Task 2: success rate % by level (App. A)", "success_rate", "level", 1),
+    ("error-group", "Task 2: error rate % by task group", "error_rate", "task_group", 1),
+    ("pearson-state", "App. H: Pearson r by state type", "pearson", "state_type", 2),
+    ("pearson-context", "App. H: Pearson r by frames in context", "pearson", "context", 2),
+    ("error-state", "App. H: error rate % by state type", "error_rate", "state_type", 1),
+    ("error-context", "App. H: error rate % by frames in context", "error_rate", "context", 1),
+    ("voc-dataset", "App. L: VOC by dataset", "voc", "dataset", 3),
+    (
+        "framecorr-dataset",
+        "App. L: correlation with frame number by dataset",
+        "frame_corr",
+        "dataset",
+        3,
+    ),
+    ("pearson-dataset", "App. L: Pearson r with ground truth by dataset", "pearson", "dataset", 3),
+]
+
+
+def run_tables(metrics: dict[str, Any]) -> list[Table]:
+    """Every table of the run, in reading order (the main table first)."""
+    from rover.eval.results import inconclusive_warnings
+
+    labels = {v["id"]: v["label"] or v["id"] for v in metrics.get("variants", [])}
+    warnings = [
+        f"{labels.get(vid, vid)}: the judge left {share:.0f}% of its frames inconclusive, so "
+        "its error rate rests on fewer than 70% of its frames."
+        for vid, share in inconclusive_warnings(metrics).items()
+    ]
+    out = [
+        Table(
+            "main",
+            "Main results (mean ± standard error over videos)",
+            *main_rows(metrics),
+            note=MAIN_NOTE,
+            warnings=warnings,
+        )
+    ]
+    pooled = pooled_rows(metrics)
+    if pooled is not None:
+        out.append(Table("qa-pooled", "Video QA pooled over questions (secondary)", *pooled))
+    for tid, title, metric, by, digits in PIVOTS:
+        t = pivot(metrics, metric, by, digits)
+        if t is not None:
+            out.append(Table(tid, title, *t))
+    for dim, title, names in SWEEPS:
+        for metric in names:
+            t = sweep_pivot(metrics, dim, metric, 1 if metric in ("l2", "error_rate") else 2)
+            if t is not None:
+                name = f"{title}: {METRIC_NAMES.get(metric, metric)}"
+                out.append(Table(f"sweep-{dim}-{metric}", name, *t))
+    for t in (_cost_table(metrics), _error_table(metrics)):
+        if t is not None:
+            out.append(t)
+    return out
+
+
 def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
     """The whole summary.md."""
     out = ["# rover eval summary", ""]
@@ -220,78 +306,27 @@ def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
             "> an upper bound / pipeline check, not a VLM's performance.",
             "",
         ]
-    out += [
-        "## Main results (mean ± standard error over videos)",
-        "",
-        markdown_table(*main_rows(metrics)),
-        "",
-        "Rates are percentages. QA columns are per-video means (the paper's and its "
-        "reference code's aggregation); Δt is predicted minus true frame (negative: too "
-        "early), |Δt| its size, over correctly answered 'yes' questions.",
-        "",
-    ]
-    from rover.eval.results import inconclusive_warnings
-
-    labels = {v["id"]: v["label"] or v["id"] for v in metrics.get("variants", [])}
-    for vid, share in inconclusive_warnings(metrics).items():
-        out.append(
-            f"- **{labels.get(vid, vid)}: the judge left {share:.0f}% of its frames "
-            "inconclusive**, so its error rate rests on fewer than 70% of its frames."
-        )
-    if inconclusive_warnings(metrics):
-        out.append("")
-    pooled = pooled_rows(metrics)
-    if pooled is not None:
-        out += ["## Video QA pooled over questions (secondary)", "", markdown_table(*pooled), ""]
+    tables = run_tables(metrics)
     notes = metrics.get("notes", [])
-    if notes:
-        out += ["## Not applicable to this run", ""] + [f"- {n}" for n in notes] + [""]
-    sections = [
-        ("Task 1: Pearson r by task group (Fig. 3)", "pearson", "task_group", 2),
-        ("Task 1: Pearson r by level (Fig. 3)", "pearson", "level", 2),
-        ("Task 1: L2 distance by level (App. A)", "l2", "level", 1),
-        (
-            "Task 1: correlation with frame number by non-expert share (App. A)",
-            "frame_corr",
-            "nonexpert",
-            2,
-        ),
-        ("Task 2: error rate % by level (Fig. 5)", "error_rate", "level", 1),
-        ("Task 2: success rate % by level (App. A)", "success_rate", "level", 1),
-        ("Task 2: error rate % by task group", "error_rate", "task_group", 1),
-        ("App. H: Pearson r by state type", "pearson", "state_type", 2),
-        ("App. H: Pearson r by frames in context", "pearson", "context", 2),
-        ("App. H: error rate % by state type", "error_rate", "state_type", 1),
-        ("App. H: error rate % by frames in context", "error_rate", "context", 1),
-        ("App. L: VOC by dataset", "voc", "dataset", 3),
-        ("App. L: correlation with frame number by dataset", "frame_corr", "dataset", 3),
-        ("App. L: Pearson r with ground truth by dataset", "pearson", "dataset", 3),
-    ]
-    for title, metric, by, digits in sections:
-        t = pivot(metrics, metric, by, digits)
-        if t is not None and (by != "dataset" or len(t[1]) > 0):
-            out += [f"## {title}", "", markdown_table(*t), ""]
-    for dim, title, names in SWEEPS:
-        for metric in names:
-            t = sweep_pivot(metrics, dim, metric, 1 if metric == "l2" else 2)
-            if t is not None:
-                out += [
-                    f"## {title}: {METRIC_NAMES.get(metric, metric)}",
-                    "",
-                    markdown_table(*t),
-                    "",
-                ]
-    out += _cost_section(metrics) + _error_section(metrics) + _counts_section(metrics)
+    for i, t in enumerate(tables):
+        out += [f"## {t.title}", "", markdown_table(t.headers, t.rows), ""]
+        if t.note:
+            out += [t.note, ""]
+        if t.warnings:
+            out += [f"- **{w}**" for w in t.warnings] + [""]
+        if i == 0 and notes:
+            out += ["## Not applicable to this run", ""] + [f"- {n}" for n in notes] + [""]
+    out += _counts_section(metrics)
     return "\n".join(out).rstrip() + "\n"
 
 
-def _cost_section(metrics: dict[str, Any]) -> list[str]:
+def _cost_table(metrics: dict[str, Any]) -> Table | None:
     rows: dict[tuple, dict[str, Any]] = {}
     labels = {v["id"]: v["label"] for v in metrics.get("variants", [])}
     for c in metrics.get("cost", []):
         rows.setdefault((c["variant"], c["frames"]), {})[c["metric"]] = c
     if not rows:
-        return []
+        return None
     body = []
     for (variant, frames), m in sorted(rows.items(), key=lambda kv: (str(kv[0][1]), kv[0][0])):
         tok, calls = m.get("total_tokens"), m.get("calls")
@@ -305,13 +340,13 @@ def _cost_section(metrics: dict[str, Any]) -> list[str]:
             ]
         )
     headers = ["Method", "Frames", "Avg tokens per video", "Avg VLM calls per video", "n"]
-    return ["## Inference cost (App. F)", "", markdown_table(headers, body), ""]
+    return Table("cost", "Inference cost (App. F)", headers, body)
 
 
-def _error_section(metrics: dict[str, Any]) -> list[str]:
+def _error_table(metrics: dict[str, Any]) -> Table | None:
     rows = metrics.get("error_analysis", [])
     if not rows:
-        return []
+        return None
     variants = list(dict.fromkeys(r["variant"] for r in rows))
     labels = {v["id"]: v["label"] for v in metrics.get("variants", [])}
     names = {
@@ -329,15 +364,14 @@ def _error_section(metrics: dict[str, Any]) -> list[str]:
             r = cell.get((v, k))
             line.append("NA" if not r or r["mean"] is None else f"{r['mean']:.0f}%")
         body.append(line)
-    return [
-        "## Error analysis: share of videos with each error type "
+    return Table(
+        "errors",
+        "Error analysis: share of videos with each error type "
         "(Sec. 5 Table 1, types in App. C.4; derived)",
-        "",
-        markdown_table(["Error type"] + [labels.get(v, v) for v in variants], body),
-        "",
-        "Derivation rules: docs/evaluation.md#error-analysis.",
-        "",
-    ]
+        ["Error type"] + [labels.get(v, v) for v in variants],
+        body,
+        note="Derivation rules: docs/evaluation.md#error-analysis.",
+    )
 
 
 def _judge_line(metrics: dict[str, Any], run: dict[str, Any], role: str) -> str:
