@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rover.episode import FrameFacts, ObjectFacts
-from rover.errors import BackendError
+from rover.errors import BackendError, InputError
 from rover.methods import get_method
 from rover.methods.registry import NON_VLM_METHODS, method_names
 from rover.vlm.config import BackendConfig
@@ -62,7 +62,7 @@ async def test_oracle_noise_is_seeded(make_episode):
 
 async def test_oracle_refuses_episodes_without_truth(make_episode):
     ep = make_episode(6).model_copy(update={"truth": None})
-    with pytest.raises(BackendError, match="has none — use a real backend or replay"):
+    with pytest.raises(InputError, match="has no ground truth: use a real backend"):
         await get_method("rover").run(ep, OracleBackend())
     with pytest.raises(BackendError, match="bound"):
         await OracleBackend().complete(Prompt(messages=[], meta=PromptMeta(kind="rover.step")))

@@ -41,7 +41,7 @@ async def test_window_k3_exact_frames(make_episode, scripted):
         ("rover.step", [0, 1, 2]),
         ("rover.step", [0, 2, 3]),
         ("rover.step", [0, 3, 4]),  # A reaches 100%
-        ("rover.parent", []),  # text-only parent turn
+        ("rover.parent", [4]),  # parent turn: ψ shows A's final frame
         ("rover.step", [4, 5]),  # child B starts at A's final frame (φ)
         ("rover.step", [4, 5, 6]),
         ("rover.step", [4, 6, 7]),
@@ -126,16 +126,19 @@ async def test_recursion_depth_two_and_return(make_episode, scripted):
         ("rover.step", [0, 1]),  # A decomposes at frame 1
         ("rover.step", [1, 2]),  # A1 starts at A's last frame (φ)
         ("rover.step", [1, 2, 3]),  # A1 done
-        ("rover.parent", []),  # A: "The robot has completed: A1" -> A2
+        ("rover.parent", [3]),  # A: "The robot has completed: A1" + its final frame -> A2
         ("rover.step", [3, 4]),  # A2 starts at A1's final frame (ψ)
-        ("rover.parent", []),  # A: -> Task complete
-        ("rover.parent", []),  # root: -> B
+        ("rover.parent", [4]),  # A: -> Task complete
+        ("rover.parent", [4]),  # root: -> B
         ("rover.step", [4, 5]),
         ("rover.step", [4, 5, 6]),
-        ("rover.parent", []),  # root: Task complete
+        ("rover.parent", [6]),  # root: Task complete
     ]
-    parent_text = vlm.prompts[4].messages[1].content[0].text
+    parts = vlm.prompts[4].messages[1].content
+    parent_text = " ".join(p.text for p in parts if isinstance(p, TextPart))
     assert "The robot has completed: A1" in parent_text and "d3" in parent_text
+    # ψ returns the child's final frame: its image sits before its final description
+    assert [p.frame_index for p in parts if isinstance(p, ImagePart)] == [3]
     root = trace.tree
     assert [c.subtask for c in root.children] == ["A", "B"]
     a = root.children[0]

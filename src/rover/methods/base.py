@@ -4,10 +4,17 @@ A method turns an Episode and a VLM into a Trace. The `Session` here makes each 
 call, re-asks once with a format reminder when the reply cannot be used, and records
 every call (frames sent, tokens, latency, cache hit, parse outcome) in the trace, so the
 methods themselves only say *what* to ask and what to do with the answer.
+
+Each call's completion budget is sized to the frames it asks about (`budget.py`). A reply
+that stopped at that budget is recorded as truncated and, when frames are missing, re-asked
+once for just those frames. CPU-heavy work (encoding frames, parsing long replies) runs in a
+worker thread so one episode's parsing never stalls the other episodes' calls.
 """
 
 from __future__ import annotations
 
+import asyncio
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -15,6 +22,9 @@ from datetime import UTC, datetime
 from typing import Any, TypeVar
 
 from rover.episode import Episode
+from rover.methods.budget import budget_for
+from rover.methods.parse import reply_capped
+from rover.methods.prompts import render
 from rover.methods.trace import CallRecord, Trace
 from rover.vlm.types import (
     VLM,
@@ -25,10 +35,13 @@ from rover.vlm.types import (
     Message,
     Prompt,
     PromptMeta,
+    SamplingParams,
     TextPart,
 )
 
 T = TypeVar("T")
+_INLINE_PARSE_CHARS = 8192  # shorter replies parse in microseconds: no thread hop
+_ENCODE_LOCK = threading.Lock()  # the image memo is shared by every session's threads
 
 
 @dataclass
@@ -50,8 +63,20 @@ class Method:
 
     name: str = ""
 
+    max_tokens: int | None = None  # fixed completion budget per call (None: sized per call)
+    tokens_per_frame: int | None = None  # budget per frame asked about (None: the default)
+
     def __init__(self, **params: Any) -> None:
         self.params: dict[str, Any] = params
+
+    def budget_options(self, max_tokens: int | None, tokens_per_frame: int | None) -> None:
+        """Keep the completion-budget overrides (recorded in params only when given)."""
+        if max_tokens is not None:
+            self.max_tokens = int(max_tokens)
+            self.params["max_tokens"] = self.max_tokens
+        if tokens_per_frame is not None:
+            self.tokens_per_frame = int(tokens_per_frame)
+            self.params["tokens_per_frame"] = self.tokens_per_frame
 
     async def run(self, episode: Episode, vlm: VLM, on_step: OnStep | None = None) -> Trace:
         raise NotImplementedError
@@ -71,6 +96,9 @@ class Session:
         self.encoding: ImageEncoding = getattr(vlm, "image_encoding", None) or ImageEncoding()
         self._parts: dict[int, ImagePart] = {}
         self.lines_started = 0  # ROVER: ids for lines of reasoning
+        self.budget = budget_for(vlm, method.max_tokens, method.tokens_per_frame)
+        make = getattr(vlm, "default_params", None)
+        self._params: SamplingParams = make() if callable(make) else SamplingParams()
         self.trace = Trace.start(
             episode, method.name, method.params, vlm.backend, vlm.model, oracle=is_oracle(vlm)
         )
@@ -83,10 +111,21 @@ class Session:
         """The image part of one frame; each frame is encoded once per run."""
         part = self._parts.get(position)
         if part is None:
-            enc = EncodedImage.from_any(self.frames[position], self.encoding)
+            with _ENCODE_LOCK:
+                enc = EncodedImage.from_any(self.frames[position], self.encoding)
             part = ImagePart(image=enc, frame_index=self.episode.frame_indices[position])
             self._parts[position] = part
         return part
+
+    async def prefetch(self, positions: list[int]) -> None:
+        """Encode the frames a prompt will show in a worker thread (the loop stays free)."""
+        todo = [p for p in dict.fromkeys(positions) if p not in self._parts]
+        if todo:
+            await asyncio.to_thread(lambda: [self.image(p) for p in todo])
+
+    def params(self, frames: int) -> SamplingParams:
+        """Sampling parameters for a call answering `frames` frames (its token budget)."""
+        return self._params.model_copy(update={"max_tokens": self.budget.tokens(frames)})
 
     def meta(self, kind: str, positions: list[int], **kw: Any) -> PromptMeta:
         return PromptMeta(
@@ -105,46 +144,72 @@ class Session:
         usable: Callable[[T], bool],
         reminder: str,
         line_id: int | None = None,
+        frames: int = 1,
+        missing: Callable[[T], list[int]] | None = None,
     ) -> tuple[T, bool]:
         """Ask; on an unusable reply ask once more with a format reminder.
+
+        `frames` is how many frames the reply must answer (it sizes the token budget).
+        When the reply stopped at its budget and `missing(parsed)` names frame labels it
+        did not reach, the re-ask asks for exactly those, with a budget for them.
 
         Returns (parsed reply, ok). When both replies are unusable, `ok` is False and the
         second reply's parse is returned so callers can salvage what is there.
         """
         messages = [Message(role="system", content=system), Message(role="user", content=content)]
         prompt = Prompt(messages=messages, meta=meta)
-        completion = await self._complete(prompt)
-        parsed = parse(completion.text)
+        params = self.params(frames)
+        completion = await self._complete(prompt, params)
+        parsed = await self._parse(parse, completion.text)
         if usable(parsed):
-            self._record(prompt, completion, "ok", line_id)
+            self._record(prompt, completion, "ok", line_id, params)
             return parsed, True
-        self._record(prompt, completion, "retried", line_id)
+        cut = self._record(prompt, completion, "retried", line_id, params).truncated
+        gone = missing(parsed) if cut and missing is not None else []
+        if gone:
+            frames = len(gone)
+            reminder = render("truncated_reminder", which=label_list(gone)) + "\n" + reminder
         retry = Prompt(
             messages=[
                 *messages,
                 Message(role="assistant", content=completion.text or "(empty reply)"),
                 Message(role="user", content=reminder),
             ],
-            meta=meta.model_copy(update={"extra": {**meta.extra, "reminder": True}}),
+            meta=meta.model_copy(
+                update={"extra": {**meta.extra, "reminder": True, "missing": list(gone)}}
+            ),
         )
-        completion2 = await self._complete(retry)
-        parsed2 = parse(completion2.text)
+        params2 = self.params(frames)
+        completion2 = await self._complete(retry, params2)
+        parsed2 = await self._parse(parse, completion2.text)
         ok = usable(parsed2)
         # both calls stay in the trace: the first as "retried", this one "ok" or "failed"
-        self._record(retry, completion2, "ok" if ok else "failed", line_id)
+        self._record(retry, completion2, "ok" if ok else "failed", line_id, params2)
         return parsed2, ok
 
-    async def _complete(self, prompt: Prompt) -> Completion:
+    async def _parse(self, parse: Callable[[str], T], text: str) -> T:
+        if len(text) <= _INLINE_PARSE_CHARS:
+            return parse(text)
+        return await asyncio.to_thread(parse, text)
+
+    async def _complete(self, prompt: Prompt, params: SamplingParams) -> Completion:
         t0 = time.perf_counter()
-        completion = await self.vlm.complete(prompt)
+        completion = await self.vlm.complete(prompt, params)
         if not completion.latency_s:
             completion = completion.model_copy(update={"latency_s": time.perf_counter() - t0})
         return completion
 
     def _record(
-        self, prompt: Prompt, completion: Completion, parse: str, line_id: int | None
+        self,
+        prompt: Prompt,
+        completion: Completion,
+        parse: str,
+        line_id: int | None,
+        params: SamplingParams,
     ) -> CallRecord:
         u = completion.usage
+        # cached replies lose the stop reason: a reply as long as the budget was cut too
+        truncated = completion.truncated or u.completion_tokens >= params.max_tokens
         rec = CallRecord(
             id=len(self.trace.calls),
             kind=prompt.meta.kind,
@@ -159,6 +224,10 @@ class Session:
             cached=completion.cached,
             parse=parse,  # type: ignore[arg-type]
             response=completion.text,
+            max_tokens=params.max_tokens,
+            finish_reason=completion.finish_reason,
+            truncated=truncated,
+            reply_capped=reply_capped(completion.text),
         )
         self.trace.calls.append(rec)
         return rec
@@ -200,3 +269,13 @@ def is_oracle(vlm: VLM) -> bool:
 
 def text(s: str) -> TextPart:
     return TextPart(text=s)
+
+
+def label_list(labels: list[int]) -> str:
+    """ "frame 3", "frames 3, 5 and 9", "frames 10 to 29" (runs of consecutive labels)."""
+    labels = sorted(labels)
+    if len(labels) == 1:
+        return f"frame {labels[0]}"
+    if labels == list(range(labels[0], labels[-1] + 1)):
+        return f"frames {labels[0]} to {labels[-1]}"
+    return "frames " + ", ".join(map(str, labels[:-1])) + f" and {labels[-1]}"

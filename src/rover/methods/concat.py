@@ -17,6 +17,7 @@ from rover.methods.gvl import (
     FIRST_FRAME_DESCRIPTION,
     accumulating_parser,
     apply_answer,
+    frames_missing,
     frames_usable,
     gather_limited,
 )
@@ -32,8 +33,15 @@ class TemporalConcat(Method):
     name = "temporal-concat"
     local: int | None = None  # frames kept per call (None: all so far)
 
-    def __init__(self, concurrency: int = 8, **_ignored: Any) -> None:
+    def __init__(
+        self,
+        concurrency: int = 8,
+        max_tokens: int | None = None,
+        tokens_per_frame: int | None = None,
+        **_ignored: Any,
+    ) -> None:
         super().__init__()
+        self.budget_options(max_tokens, tokens_per_frame)
         self.concurrency = int(concurrency)
 
     def context(self, t: int) -> list[int]:
@@ -52,6 +60,7 @@ class TemporalConcat(Method):
 
     async def _call(self, s: Session, system: str, t: int) -> None:
         shown = self.context(t)
+        await s.prefetch(shown)
         content: list[TextPart | ImagePart] = []
         for pos in shown:
             if pos == t:
@@ -92,14 +101,18 @@ class VideoConcat(Method):
 
     name = "video-concat"
 
-    def __init__(self, **_ignored: Any) -> None:
+    def __init__(
+        self, max_tokens: int | None = None, tokens_per_frame: int | None = None, **_ignored: Any
+    ) -> None:
         super().__init__()
+        self.budget_options(max_tokens, tokens_per_frame)
 
     async def run(self, episode: Episode, vlm: VLM, on_step: OnStep | None = None) -> Trace:
         vlm = vlm.bind(episode)
         s = Session(self, episode, vlm, on_step)
         system = render("video_system", task_description=episode.task)
         n = s.num_frames
+        await s.prefetch(list(range(n)))
         content: list[TextPart | ImagePart] = []
         for pos in range(n):
             content += [text(f"Frame {pos}:"), s.image(pos)]
@@ -113,6 +126,8 @@ class VideoConcat(Method):
             accumulating_parser(acc),
             frames_usable(list(range(1, n))),
             reminder,
+            frames=n,
+            missing=frames_missing(list(range(1, n))),
         )
         for pos in range(n):
             apply_answer(s, pos, answers.get(pos))

@@ -34,6 +34,15 @@ def frames_usable(needed: list[int]):
     return usable
 
 
+def frames_missing(needed: list[int]):
+    """The needed labels a reply left without a progress value (re-asked after a cut)."""
+
+    def missing(answers: dict[int, FrameAnswer]) -> list[int]:
+        return [k for k in needed if k not in answers or answers[k].progress is None]
+
+    return missing
+
+
 def accumulating_parser(acc: dict[int, FrameAnswer]):
     """parse_frames, merged into `acc` so a re-ask's answers fill the first reply's gaps."""
 
@@ -48,14 +57,18 @@ def accumulating_parser(acc: dict[int, FrameAnswer]):
 
 
 def apply_answer(s: Session, position: int, ans: FrameAnswer | None) -> None:
-    """Write one frame's answer into the trace (progress on 0..100 of the full task)."""
+    """Write one frame's answer into the trace (full-task progress, as the model gave it).
+
+    Values below 0 (the prompts ask for negative progress after a regression) or above
+    100 are kept; metrics decide whether to clip.
+    """
     if ans is None:
         return
     fr = s.trace.frames[position]
     if ans.description:
         fr.description = ans.description
     if ans.progress is not None and position > 0:
-        fr.progress = min(max(ans.progress, 0.0), 100.0)
+        fr.progress = ans.progress
         fr.subtask_progress = ans.progress
         fr.predicted = True
 
@@ -91,8 +104,16 @@ class GVL(Method):
     name = "gvl"
     per_timestep = True
 
-    def __init__(self, seed: int = 0, concurrency: int = 8, **_ignored: Any) -> None:
+    def __init__(
+        self,
+        seed: int = 0,
+        concurrency: int = 8,
+        max_tokens: int | None = None,
+        tokens_per_frame: int | None = None,
+        **_ignored: Any,
+    ) -> None:
         super().__init__(seed=int(seed))
+        self.budget_options(max_tokens, tokens_per_frame)
         self.seed = int(seed)
         self.concurrency = int(concurrency)
 
@@ -113,6 +134,7 @@ class GVL(Method):
         return s.finish()
 
     async def _call(self, s: Session, system: str, order: list[int]) -> None:
+        await s.prefetch([0, *order])
         content: list[TextPart | ImagePart] = [
             text("Initial robot scene:"),
             s.image(0),
@@ -133,7 +155,14 @@ class GVL(Method):
             "frames_reminder", which=f"frames 1 to {len(order)}" if len(order) > 1 else "frame 1"
         )
         answers, _ok = await s.ask(
-            system, content, meta, accumulating_parser(acc), frames_usable(needed), reminder
+            system,
+            content,
+            meta,
+            accumulating_parser(acc),
+            frames_usable(needed),
+            reminder,
+            frames=len(order),  # the prompt asks for every shown frame
+            missing=frames_missing(needed),
         )
         if self.per_timestep:
             apply_answer(s, target, answers.get(needed[0]))

@@ -14,9 +14,14 @@ Algorithm 1, as implemented by `Rover._line` (comments cite its line numbers):
 
 φ gives the child its subtask and the parent's last frame (with its description) as the
 child's "initial robot scene" at 0%; ψ hands back the child's final frame and final
-description. After a child returns, the parent gets a text-only turn ("The robot has
-completed: ...") and answers with the next subtask or "Task complete" (or, rarely, its
-own progress, and then it carries on frame by frame itself).
+description. After a child returns, the parent gets a turn showing its plan, what is done,
+and the child's final frame with its description ("The robot has completed: ..."), and
+answers with the next subtask or "Task complete" (or, rarely, its own progress, and then
+it carries on frame by frame itself).
+
+Plans are part of the protocol: a decomposition answers "New subtasks: [...]" then "The
+robot needs to: <first>", as the paper's examples and the public reference code do. The
+plan's length is the n that stitching divides by (grown only if the model adds subtasks).
 """
 
 from __future__ import annotations
@@ -76,6 +81,8 @@ class Rover(Method):
         max_subtasks: int = 8,
         recursion: bool = True,
         prev_frame_policy: PrevFramePolicy = "always",
+        max_tokens: int | None = None,
+        tokens_per_frame: int | None = None,
         **_ignored: Any,
     ) -> None:
         if prev_frame_policy not in ("always", "on_change"):
@@ -92,6 +99,7 @@ class Rover(Method):
             recursion=bool(recursion),
             prev_frame_policy=prev_frame_policy,
         )
+        self.budget_options(max_tokens, tokens_per_frame)
         self.window = window
         self.threshold = float(threshold)
         self.max_depth = int(max_depth) if recursion else 0
@@ -159,10 +167,7 @@ class Rover(Method):
                 t += 1
                 continue
             if reply.new_subtask and self._can_decompose(line):  # line 6: new task
-                if reply.plan and len(reply.plan) > 1:
-                    line.plan = list(reply.plan)
-                    line.node.planned_subtasks = list(reply.plan)
-                    line.stitch.planned = max(line.stitch.planned, len(reply.plan))
+                self._take_plan(line, reply)
                 anchor = Seen(t, reply.description or line.last_description, 0.0)
                 s.step(t, [*line.path, reply.new_subtask], None)
                 child = await self._child(s, line, reply.new_subtask, anchor)  # line 7
@@ -204,6 +209,8 @@ class Rover(Method):
                 return self._end_none(s, line, "end_of_video")
             reply, ok = await self._parent_turn(s, line, child)
             f = child.last_position
+            if ok:
+                self._take_plan(line, reply)
             want_more = ok and reply.new_subtask is not None
             if not ok and len(line.plan) > len(line.completed):
                 want_more, reply.new_subtask = True, line.plan[len(line.completed)]
@@ -221,6 +228,13 @@ class Rover(Method):
             elif ok:  # "Task complete"
                 return self._end_none(s, line, "complete")
             return f + 1  # carry on frame by frame in this line
+
+    def _take_plan(self, line: _Line, reply: StepReply) -> None:
+        """A plan the model announced sets n; a longer one later replaces it."""
+        if reply.plan and len(reply.plan) > len(line.plan):
+            line.plan = list(reply.plan)
+            line.node.planned_subtasks = list(reply.plan)
+            line.stitch.planned = max(line.stitch.planned, len(reply.plan))
 
     def _end(self, s: Session, line: _Line, outcome: str) -> _Line:
         line.node.outcome = outcome  # type: ignore[assignment]
@@ -259,10 +273,12 @@ class Rover(Method):
         content: list[TextPart | ImagePart] = []
         if t == line.first.position:  # c: task + first observation, nothing said yet
             shown = [t]
+            await s.prefetch(shown)
             content += [text("Initial robot scene (current frame):"), s.image(t)]
         else:
             window = window_frames(line.first, line.history, self.window)
             shown = [w.position for w in window] + [t]
+            await s.prefetch(shown)
             for i, w in enumerate(window):
                 label = (
                     "Initial robot scene:"
@@ -295,7 +311,10 @@ class Rover(Method):
         )
         reminder = render(
             "rover_reminder",
-            decompose_format="or\nFrame description: {}\nThe robot needs to: {}" if can else "",
+            decompose_format="or\nFrame description: {}\nNew subtasks: [{}, {}, ...]\n"
+            "The robot needs to: {}"
+            if can
+            else "",
         )
         line.node.calls += 1
         return await s.ask(
@@ -314,30 +333,42 @@ class Rover(Method):
             task_description=line.subtask,
             decomposition=render("rover_decompose"),
         )
+        # ψ: the child's final frame and its final description
+        f = child.last_position
+        await s.prefetch([f])
+        plan = "[" + ", ".join(f"'{p}'" for p in line.plan) + "]" if line.plan else "none given"
         body = render(
             "rover_parent",
+            plan=plan,
             completed_subtask=child.subtask,
             final_description=child.last_description or "unavailable",
             completed_list="; ".join(line.completed),
             task_description=line.subtask,
         )
+        before, _, after = body.partition("{image}")
+        content: list[TextPart | ImagePart] = [
+            text(before.rstrip("\n")),
+            s.image(f),
+            text(after.lstrip("\n")),
+        ]
         meta = s.meta(
             "rover.parent",
-            [],
+            [f],
             subtask=line.subtask,
             subtask_path=list(line.path),
             extra={
                 "line_id": line.id,
                 "depth": line.depth,
                 "completed": list(line.completed),
-                "at_position": child.last_position,
-                "at_frame": s.episode.frame_indices[child.last_position],
+                "plan": list(line.plan),
+                "at_position": f,
+                "at_frame": s.episode.frame_indices[f],
             },
         )
         line.node.calls += 1
         return await s.ask(
             system,
-            [text(body)],
+            content,
             meta,
             parse_step,
             lambda r: r.usable_step,

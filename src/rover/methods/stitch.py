@@ -1,11 +1,16 @@
-"""Stitching ROVER's per-line subtask progress into one 0-100 curve over the full task.
+"""Stitching ROVER's per-line subtask progress into one curve over the full task.
 
-Paper Sec. 5.1 / App. E: within a line of reasoning that ended up with n subtasks, the
-i-th subtask (0-based) covers `100*i/n .. 100*(i+1)/n` of its parent's range, so a child
-value p maps to `100*i/n + p/n`; nesting composes the same mapping. n is the number of
-subtasks the line ended up with, or the number it announced up front when the model gave
-a plan ("New Subtasks: [...]"), whichever is larger. Frames nobody predicted are filled
-forward; frame 0 is 0.
+Paper Sec. 5.1: "we divide the values within each subtask by the total number of
+subtasks and add them to the value for the last timestep of the previous subtask". A line
+whose values are worth `scale` points of the full task, starting from full-task value
+`base`, maps its subtask i's value p to `base_i + scale * p / (100 n)`, where `base_0` is
+the line's base and `base_(i+1)` the full-task value at subtask i's last frame; nested
+lines compose the same way. So with n = 2, a video that stops at 70% of subtask 1 scores
+35, and a subtask 1 that ended at 90% hands subtask 2 a start of 45.
+
+n is the length of the plan the model announced ("New subtasks: [...]"), grown only when
+it adds subtasks beyond it. Values are not clipped (negative progress after a regression
+is kept, as the prompts ask); frames nobody predicted are filled forward; frame 0 is 0.
 """
 
 from __future__ import annotations
@@ -51,36 +56,31 @@ class Value:
     line: StitchLine
 
 
-def _clamp(p: float, lo: float = -100.0, hi: float = 100.0) -> float:
-    return min(max(p, lo), hi)
-
-
 def line_values(
-    line: StitchLine, lo: float = 0.0, hi: float = 100.0
-) -> tuple[dict[int, Value], dict[int, float]]:
-    """Full-task values of a line's predictions (later ones win) and of its anchors.
+    line: StitchLine, base: float = 0.0, scale: float = 100.0
+) -> tuple[dict[int, Value], dict[int, float], float]:
+    """Full-task values of a line's predictions (later ones win), of its anchors, and its end.
 
-    Returns (predicted, anchors): `predicted[pos]` from the model's answers, `anchors[pos]`
-    the 0% start of each line mapped to the full task, used only where nothing was predicted.
+    Returns (predicted, anchors, end): `predicted[pos]` from the model's answers,
+    `anchors[pos]` the 0% start of each line mapped to the full task (used only where
+    nothing was predicted), and `end`, the full-task value at the line's last answer.
     """
     predicted: dict[int, Value] = {}
-    anchors: dict[int, float] = {line.first_position: lo}
-    n = line.n_subtasks
-    child_i = 0
+    anchors: dict[int, float] = {line.first_position: base}
+    n = max(line.n_subtasks, 1)
+    start = end = base  # start: the value at the previous subtask's last frame
     for item in line.items:
         if isinstance(item, Point):
             # a decomposed line's own answers are on its own 0-100 scale
-            v = lo + (hi - lo) * _clamp(item.progress) / 100.0
-            predicted[item.position] = Value(v, item.progress, line)
+            end = base + scale * item.progress / 100.0
+            predicted[item.position] = Value(end, item.progress, line)
         else:
-            c_lo = lo + (hi - lo) * child_i / n
-            c_hi = lo + (hi - lo) * (child_i + 1) / n
-            sub_pred, sub_anchor = line_values(item, c_lo, c_hi)
+            sub_pred, sub_anchor, end = line_values(item, start, scale / n)
             predicted.update(sub_pred)
             for pos, v in sub_anchor.items():
                 anchors.setdefault(pos, v)
-            child_i += 1
-    return predicted, anchors
+            start = end
+    return predicted, anchors, end
 
 
 def fill_forward(values: list[float | None], first: float = 0.0) -> list[float]:
@@ -97,13 +97,12 @@ def fill_forward(values: list[float | None], first: float = 0.0) -> list[float]:
 
 
 def stitch(root: StitchLine, num_frames: int) -> tuple[list[float], dict[int, Value]]:
-    """One curve over the full task (0-100 per frame position) plus the per-frame sources."""
-    predicted, anchors = line_values(root)
+    """One curve over the full task (per frame position) plus the per-frame sources."""
+    predicted, anchors, _ = line_values(root)
     raw: list[float | None] = []
     for pos in range(num_frames):
         if pos in predicted:
             raw.append(predicted[pos].progress)
         else:
             raw.append(anchors.get(pos))
-    curve = [min(max(v, 0.0), 100.0) for v in fill_forward(raw)]
-    return curve, predicted
+    return fill_forward(raw), predicted

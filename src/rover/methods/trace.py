@@ -44,6 +44,10 @@ class CallRecord(BaseModel):
     parse: Literal["ok", "retried", "failed"] = "ok"
     response: str = ""
     error: str | None = None
+    max_tokens: int | None = None  # the completion budget sent with the call
+    finish_reason: str | None = None  # as the provider said ("stop", "length", "MAX_TOKENS")
+    truncated: bool = False  # the reply stopped at max_tokens
+    reply_capped: bool = False  # longer than the parsers read (64 KB / 2,000 lines)
 
 
 class LineNode(BaseModel):
@@ -73,6 +77,8 @@ class Totals(BaseModel):
     latency_s: float = 0.0
     parse_failures: int = 0
     parse_retries: int = 0
+    truncated_replies: int = 0  # replies that stopped at their completion budget
+    capped_replies: int = 0  # replies longer than the parsers read
 
 
 class Trace(BaseModel):
@@ -138,6 +144,8 @@ class Trace(BaseModel):
             t.latency_s += c.latency_s
             t.parse_failures += int(c.parse == "failed")
             t.parse_retries += int(c.parse == "retried")
+            t.truncated_replies += int(c.truncated)
+            t.capped_replies += int(c.reply_capped)
         t.total_tokens = t.prompt_tokens + t.completion_tokens
         return t
 
