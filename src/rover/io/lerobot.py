@@ -38,6 +38,7 @@ from PIL import Image, UnidentifiedImageError
 from rover.episode import Episode
 from rover.errors import InputError
 from rover.io.frames import stack_frames, to_rgb_array
+from rover.io.lerobot_truth import TRUTH_COLUMNS, carries_truth, rebuild_truth
 from rover.io.plain import sample_positions
 from rover.io.seek import VideoIndex, decode_frames, index_video
 from rover.io.source import SourceReader
@@ -183,22 +184,32 @@ class LeRobotSource(SourceReader):
                 [self._decode_image(images[p], p) for p in positions],
                 f"{self.root}: column {self.camera!r} of episode {idx}",
             )
+        extra = {
+            "total_frames": length,
+            "dataset": self.root.name,
+            "episode_index": idx,
+            "robot_type": self.info.get("robot_type"),
+            "codebase_version": self.version,
+        }
+        truth, indices = None, positions
+        if carries_truth(self.info["features"], row):  # written by `rover export`
+            data = self._episode_data(idx, row, columns=TRUTH_COLUMNS)
+            names = (self.info.get("rover") or {}).get("state_types") or []
+            truth = rebuild_truth(row, data, names).at_positions(positions)
+            indices = [int(data["source_frame_index"][p]) for p in positions]
+            extra["source_episode_id"] = row.get("rover/episode_id")
         return Episode(
             id=episode_id,
             task=self.task if self.task is not None else self._task_text(idx, row),
+            task_group=row.get("rover/task_group"),
             source=f"lerobot:{self.root}",
             fps=self.fps or float(self.info["fps"]),
-            frame_indices=positions,
+            frame_indices=indices,
             view_names=list(self.cameras),
             default_view=self.camera,
             views={self.camera: pixels},
-            extra={
-                "total_frames": length,
-                "dataset": self.root.name,
-                "episode_index": idx,
-                "robot_type": self.info.get("robot_type"),
-                "codebase_version": self.version,
-            },
+            truth=truth,
+            extra=extra,
         )
 
     def _video_span(self, idx: int, row: dict[str, Any], length: Any) -> tuple[Path, int, int]:
