@@ -116,9 +116,8 @@ def scripted_answer(fcases, qcases):
         judge_by_prompt[p.messages[1].content] = (c, i % 6)
     for i, c in enumerate(qcases):
         ctx = concatenated(list(c.descriptions))
-        p = build_prompt(
-            "qa", PromptMeta(kind="scripted"), task=c.task, descriptions=ctx, question=c.item.question
-        )
+        meta = PromptMeta(kind="scripted")
+        p = build_prompt("qa", meta, task=c.task, descriptions=ctx, question=c.item.question)
         qa_by_prompt[p.messages[1].content] = (c, i % 4)
 
     def answer(body: dict) -> str:

@@ -1,12 +1,23 @@
 """Reading checkable claims out of a frame description (used by the rule judge and QA).
 
-A description such as "The gripper is closed. The robot is holding the can, which is
-lifted above the table." makes claims about a handful of things the simulator records
-(`FrameFacts`): gripper open/closed, what the gripper touches, what the robot holds,
-whether an object is lifted, where it is, how far a door/drawer/knob is open or turned,
-whether a button is pressed. Each regular expression below recognises one family of
-phrasings (the oracle's sentences and common paraphrases); anything else is ignored, so
-prose about motion ("the arm moves toward the can") yields no claim and is inconclusive.
+A description such as "The gripper is closed around the soda can, lifting it off the
+table; it is not yet in the bin." makes claims about things the simulator records
+(`FrameFacts`): gripper open/closed, what the gripper touches and holds, whether an object
+is lifted, where it is, how far a door/drawer/knob is open or turned, whether a button is
+pressed. Models write these in endless ways, so the reading is by clause, not by sentence
+template:
+
+1. markdown, "Frame description:" labels and "Gripper: open" lines become plain sentences;
+2. sentences split into clauses at commas, semicolons, "and", "while", "but", and before
+   "which"; a clause without a noun of its own continues the previous one;
+3. in each clause, mentions are found (gripper words, robot words, objects by head noun
+   with their modifiers, places such as bins and the table); "it" / "which" / "its" stand
+   for the last object mentioned;
+4. detectors look for the words of each claim family around those mentions, with the
+   clause's negation ("not", "n't", "no longer", "without", "yet to", "no") and skipping
+   intentions ("about to grasp", "preparing to press", "moving toward").
+
+Anything else — motion, intention, appearance — yields no claim and is inconclusive.
 """
 
 from __future__ import annotations
@@ -14,6 +25,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from typing import Literal
+
+from rover.eval.claim_names import names_match, normalise_name  # noqa: F401 - re-exported
 
 ClaimKind = Literal[
     "gripper",
@@ -24,6 +37,7 @@ ClaimKind = Literal[
     "lifted",
     "inside",
     "on",
+    "at_start",
     "articulation",
     "articulation_pct",
     "pressed",
@@ -36,260 +50,458 @@ class Claim:
 
     kind: ClaimKind
     subject: str | None  # object / part name as written ("can", "microwave door")
-    value: object  # True/False, "open"/"closed", a target name or a fraction 0..1
-    text: str  # the matched words, for verdict reasons
+    value: object  # True/False, "open"/"closed", (target, positive) or a fraction 0..1
+    text: str  # the clause it was read from, for verdict reasons
 
     def describe(self) -> str:
         return self.text.strip()
 
 
-_NEG = r"(?P<neg>not\s+|no\s+longer\s+|n't\s+|never\s+)?"
-_NP = r"(?P<np>(?:[\w\-']+\s+){0,3}?[\w\-']+)"
-_ART = r"(?:the|a|an)\s+"
-_STOP = (
-    r"(?=\s*(?:[,.;:!?)]|$|\s(?:and|while|but|with|as|which|that|after|before|because|so|"
-    r"now|then|still|near|above|over|from|to|towards|toward|at|in|into|on|by|of)\b))"
+_MODS = (
+    r"red|green|blue|yellow|round|square|soda|drink|coke|cylindrical|small|large|milk|"
+    r"cereal|stove|push|door|drawer|wooden|metal|white|ring-shaped|square-shaped|target|goal|"
+    r"start|starting|original|initial|correct|destination|microwave|cabinet|second|first"
 )
-_TARGET = r"(?P<target>(?:[\w\-']+\s+){0,3}?[\w\-']+)" + _STOP
-_OBJ = r"(?P<obj>(?:[\w\-']+\s+){0,3}?[\w\-']+)" + _STOP
-_BE = r"(?:is|are|'s|remains|stays|appears\s+to\s+be|seems\s+to\s+be|has\s+been|sits|rests|lies)"
-_AGENT = (
-    r"(?:robot(?:'s)?(?:\s+(?:arm|gripper|hand))?|gripper|arm|it|hand|end[\s-]effector|and|but)"
+_HEADS = (
+    r"cans?|cubes?|blocks?|milk|carton|bread|loaf|cereal|box|nut|ring|peg|post|rod|door|"
+    r"drawer|knob|dial|button|handle|bins?|table|tabletop|surface|counter|ground|floor|"
+    r"cylinder|object|item"
 )
+_PLACES = {"bin", "bins", "table", "tabletop", "surface", "counter", "ground", "floor"}
+_MENTION = re.compile(
+    rf"\b(?P<grip>gripper'?s?|fingers?|jaws|claw|end[\s-]effector|hand)\b"
+    rf"|\b(?P<robot>robot(?:'s)?|arm|panda|manipulator)\b"
+    rf"|\b(?P<pron>it|which|its)\b"
+    rf"|\b(?P<obj>(?:(?:{_MODS})\s+){{0,2}}(?:{_HEADS})(?:\s+\d+)?)\b",
+    re.I,
+)
+_NEG = re.compile(
+    r"\b(?:not|never|no\s+longer|yet\s+to|without|no|nor)\b|n't\b|\bhas\s+yet\s+to\b", re.I
+)
+_INTENT = re.compile(
+    r"(?:\b(?:to|will|would|might|may|could|should|must|before|until|trying|preparing|"
+    r"ready|about|going|attempting|planning|intends?|wants?|aims?|needs?)\s+(?:be\s+)?"
+    r"(?:\w+ly\s+)?)$",
+    re.I,
+)
+_YET_TO = re.compile(r"\byet\s+to\s+(?:\w+ly\s+)?$", re.I)
 
-_PATTERNS: list[tuple[ClaimKind, re.Pattern[str]]] = [
-    (
-        "gripper",
-        re.compile(
-            r"\bgripper(?:'s\s+fingers)?\s+(?:is|are|remains|stays|appears|has\s+been)\s+"
-            r"(?:(?P<neg>not|no\s+longer)\s+)?(?:fully\s+|completely\s+|wide\s+|still\s+)?"
-            r"(?P<state>open(?:ed)?|closed|close|shut)\b",
-            re.I,
-        ),
-    ),
-    ("gripper", re.compile(r"\b(?P<state>open|opened|closed)\s+gripper\b", re.I)),
-    (
-        "holding_any",
-        re.compile(
-            rf"\b{_AGENT}\s+(?:is\s+|isn't\s+|is\s+no\s+longer\s+)?{_NEG}"
-            rf"(?:holding|grasping|gripping|carrying)\s+(?P<none>anything|nothing)\b",
-            re.I,
-        ),
-    ),
-    ("holding_any", re.compile(r"\bgripper\s+is\s+(?P<neg>not\s+)?(?P<none>empty)\b", re.I)),
-    (
-        "holding",
-        re.compile(
-            rf"\b{_AGENT}\s+(?:is\s+|has\s+|isn't\s+|is\s+still\s+|has\s+firmly\s+)?{_NEG}"
-            rf"(?:holding|grasping|gripping|carrying|holds|grasped|gripped|picked\s+up|"
-            rf"lifted|lifting|picking\s+up)\s+(?:onto\s+)?{_ART}{_OBJ}",
-            re.I,
-        ),
-    ),
-    (
-        "holding",
-        re.compile(
-            rf"\b(?:the\s+)?{_NP}\s+(?:is|remains)\s+{_NEG}(?:held|grasped|gripped)\b"
-            rf"|\bthe\s+{_NP.replace('np', 'np2')}\s+(?:is|remains)\s+{_NEG.replace('neg', 'neg2')}"
-            rf"in\s+the\s+(?:robot's\s+)?(?:gripper|hand)\b",
-            re.I,
-        ),
-    ),
-    (
-        "contact_any",
-        re.compile(
-            rf"\b{_AGENT}\s+(?:is\s+|isn't\s+)?{_NEG}(?:touching|contacting|in\s+contact\s+with)"
-            rf"\s+(?P<none>anything|nothing)\b",
-            re.I,
-        ),
-    ),
-    (
-        "contact",
-        re.compile(
-            rf"\b{_AGENT}(?:'s\s+fingers)?\s+(?:is\s+|are\s+|has\s+|isn't\s+)?{_NEG}"
-            rf"(?:touching|contacting|in\s+contact\s+with|made\s+contact\s+with|touched|"
-            rf"making\s+contact\s+with)\s+{_ART}{_OBJ}",
-            re.I,
-        ),
-    ),
-    (
-        "articulation_pct",
-        re.compile(
-            rf"\bthe\s+{_NP}\s+(?:is|has\s+been)\s+(?:about\s+|approximately\s+|roughly\s+|"
-            rf"around\s+|now\s+)?(?P<pct>\d+(?:\.\d+)?)\s*(?:%|percent)\s*"
-            rf"(?P<state>open(?:ed)?|closed|turned|rotated)\b",
-            re.I,
-        ),
-    ),
-    (
-        "lifted",
-        re.compile(
-            rf"\bthe\s+{_NP}\s+{_BE}\s+{_NEG}(?:now\s+|still\s+)?"
-            rf"(?P<how>lifted|raised|in\s+the\s+air|off\s+the\s+(?:table|counter|ground|floor)|"
-            rf"picked\s+up|being\s+lifted)\b",
-            re.I,
-        ),
-    ),
-    (
-        "inside",
-        re.compile(
-            rf"\bthe\s+{_NP}\s+{_BE}\s+{_NEG}(?:now\s+|still\s+)?(?:inside|in|within)\s+"
-            rf"(?:the\s+)?(?!air\b|robot|gripper|hand)(?:(?:robot's|its)\s+)?{_TARGET}",
-            re.I,
-        ),
-    ),
-    (
-        "on",
-        re.compile(
-            rf"\bthe\s+{_NP}\s+{_BE}\s+{_NEG}(?:now\s+|still\s+)?(?:on\s+top\s+of|on|upon|"
-            rf"resting\s+on|sitting\s+on|lying\s+on)\s+(?:the\s+)?{_TARGET}",
-            re.I,
-        ),
-    ),
-    (
-        "pressed",
-        re.compile(
-            rf"\bthe\s+{_NP}\s+(?:is|was|has\s+(?:not\s+|never\s+)?been)\s+{_NEG}(?:now\s+)?"
-            rf"(?:pressed|pushed|depressed)\b"
-            rf"|\b(?:robot|gripper|it)\s+(?:has\s+)?{_NEG.replace('neg', 'neg2')}"
-            rf"(?:pressed|pushed|presses|pushes)\s+the\s+{_OBJ.replace('obj', 'np2')}",
-            re.I,
-        ),
-    ),
-    (
-        "articulation",
-        re.compile(
-            rf"\bthe\s+{_NP}\s+(?:is|remains|stays|has\s+been)\s+{_NEG}"
-            rf"(?P<deg>fully\s+|completely\s+|partially\s+|half\s+|slightly\s+|wide\s+)?"
-            rf"(?P<state>open(?:ed)?|closed|shut)\b",
-            re.I,
-        ),
-    ),
-]
+_GRIP_OPEN = re.compile(r"\b(?:open|opened|opens|apart|spread)\b", re.I)
+_GRIP_CLOSED = re.compile(
+    r"\b(?:closed|closes|close|shut|clamped|clenched|come\s+together)\b", re.I
+)
+_ADJ_GRIPPER = re.compile(r"\b(?P<s>open|opened|closed)\s+gripper\b", re.I)
 
-_NOT_BEEN = re.compile(r"\b(?:not|never)\s+been\b")
+_HOLD = re.compile(
+    r"\b(?:hold|holds|holding|grasp|grasps|grasped|grasping|grip|grips|gripped|gripping|"
+    r"clutch\w*|carry|carries|carried|carrying|transport\w*|"
+    r"has\s+(?:a\s+)?(?:firm\s+|secure\s+|tight\s+|good\s+)?(?:grip|grasp|hold)\s+(?:on|of)|"
+    r"(?:wrapped|clamped)\s+around|moving|moves|moved|"
+    r"lifting|lifts|lifted|raising|raises|raised|picking\s+up|picks\s+up|picked\s+up|"
+    r"picked|has\s+picked)\s+(?=the\b|a\b|an\b|it\b|its\b|onto\b)",
+    re.I,
+)
+_LIFT_VERB = re.compile(r"\b(?:lift|rais|pick)", re.I)
+_HOLD_PASSIVE = re.compile(
+    r"^\s*(?:(?:is|are|remains|stays|still|now|being|appears|seems|to|be|has|been|securely|"
+    r"firmly|tightly|safely|not|no\s+longer|isn't|yet)\s+)*"
+    r"(?:held|grasped|gripped|clamped|clutched|carried)\b"
+    r"|^\s*(?:(?:is|are|remains|stays|still|now|securely|firmly|safely|not|no\s+longer|"
+    r"isn't|yet)\s+)*"
+    r"(?:in|between|within)\s+(?:the\s+|its\s+)?(?:robot's\s+)?(?:gripper|hand|grip|claw|"
+    r"grasp|fingers|gripper\s+fingers)\b",
+    re.I,
+)
+_RELEASE = re.compile(
+    r"\b(?:released|releases|releasing|release|let\s+go|lets\s+go|letting\s+go|dropped|drops|"
+    r"dropping|opened\s+(?:its\s+)?(?:gripper\s+)?to\s+release)\b(?:\s+of)?",
+    re.I,
+)
+_EMPTY = re.compile(
+    r"\b(?:gripper|hand|claw)\s+(?:(?:is|remains|appears|seems|looks)(?:\s+to\s+be)?\s+)?"
+    r"(?:now\s+|still\s+)?(?P<e1>empty)\b|\b(?P<e2>empty)\s+(?:gripper|hand)\b"
+    r"|\b(?:holding|holds|carrying|grasping|gripping|has)\s+(?P<e3>nothing)\b"
+    r"|\b(?P<e4>nothing)\s+(?:is\s+)?(?:in|between)\s+(?:the|its)\s+(?:gripper|hand|grip|fingers)"
+    r"|\b(?:holding|holds|carrying|grasping|gripping)\s+(?P<any>anything)\b",
+    re.I,
+)
+_CONTACT = re.compile(
+    r"\b(?:touch|touches|touching|touched|contacts|contacting|contacted|in\s+contact\s+with|"
+    r"(?:made|makes|making)\s+contact\s+with|contact\s+with|pressed\s+against|presses\s+against|"
+    r"pressing\s+against|rest(?:s|ing)?\s+against|pressing\s+(?:down\s+)?on|"
+    r"pushing\s+(?:down\s+)?on|interacted\s+with|interacting\s+with|"
+    r"(?:closed|closes|closing|tightened)\s+(?:around|on))\b",
+    re.I,
+)
+_CONTACT_ANY = re.compile(
+    r"\b(?:touching|contacting|in\s+contact\s+with)\s+(?P<w>anything|nothing)\b", re.I
+)
+_LIFTED = re.compile(
+    r"\b(?:lifted|raised|elevated|suspended|airborne|(?:in|through)\s+(?:the\s+)?(?:mid-?)?air|"
+    r"off\s+the\s+(?:table|ground|surface|counter|floor|tabletop)|"
+    r"above\s+the\s+(?:table|surface|ground|counter|tabletop)|picked\s+up|"
+    r"left\s+the\s+(?:table|surface|ground))\b",
+    re.I,
+)
+_ON_TABLE = re.compile(
+    r"\b(?:on|upon|atop)\s+(?:the\s+|its\s+)?(?:table|tabletop|surface|counter|ground|floor|"
+    r"work\s+surface)\b",
+    re.I,
+)
+_AT_START = re.compile(
+    r"\b(?:original|initial|starting|start)\s+(?:location|position|place|spot)\b"
+    r"|\bwhere\s+it\s+(?:started|began|was)\b",
+    re.I,
+)
+_IN_PLACE = re.compile(
+    r"\b(?P<how>inside|into|in|within|out\s+of|outside(?:\s+of)?|reached|reaches|reach|"
+    r"onto|on|over|around)\s+(?:the\s+|its\s+|a\s+)?(?=(?:\w+\s+){0,2}?(?:bin|peg|post|rod)\b)",
+    re.I,
+)
+_ON_OBJ = re.compile(r"\b(?:stacked\s+)?(?:on\s+top\s+of|onto|on|atop|upon)\s+(?:the\s+)?", re.I)
+_PRESSED = re.compile(
+    r"\b(?:pressed|pushed|depressed)(?:\s+(?:down|in))?\b(?!\s+(?:against|on)\b)", re.I
+)
+_BUTTON_UP = re.compile(r"\bbutton\s+is\s+(?:still\s+)?(?:up|raised|unpressed)\b", re.I)
+_PART_OPEN = re.compile(
+    r"\b(?:open|opened|ajar|pulled\s+(?:\w+\s+){0,3}?out|pulled\s+open|swung\s+(?:wide\s+)?open)\b",
+    re.I,
+)
+_PART_CLOSED = re.compile(r"\b(?:closed|shut|pushed\s+in|pushed\s+closed)\b", re.I)
+_PART_TURNED = re.compile(r"\b(?:turned|rotated|twisted)\b", re.I)
+_FULL = re.compile(r"\b(?:fully|completely|wide|all\s+the\s+way|entirely)\b", re.I)
+_PARTLY = re.compile(
+    r"\b(?:partially|partly|slightly|partway|part\s+of\s+the\s+way|a\s+bit|somewhat|a\s+little|"
+    r"ajar)\b",
+    re.I,
+)
+_HALF = re.compile(r"\b(?:half|halfway|half-way)\b", re.I)
+_ALMOST = re.compile(r"\b(?:almost|nearly)\b", re.I)
+_PCT = re.compile(r"(?P<n>\d+(?:\.\d+)?)\s*(?:%|percent)", re.I)
+
+_LABEL = re.compile(
+    r"^\s*(?:frame\s+description|description|observation|observations|scene\s+state|"
+    r"key\s+observations|scene|state|summary|analysis)\s*:\s*",
+    re.I,
+)
+_KEY_VALUE = re.compile(r"^\s*(?P<k>[a-z][\w' -]{0,30}?)\s*:\s*(?P<v>.+)$", re.I)
 _SENTENCE = re.compile(r"(?<=[.!?;])\s+|\n+")
+_CLAUSE = re.compile(
+    r"\s*[,;:]\s*(?:and\s+|while\s+|but\s+|then\s+)?|\s+(?:and|while|but|whereas|though)\s+"
+    r"|\s+(?=which\b)",
+    re.I,
+)
+_PARTS = ("door", "drawer", "knob", "dial", "button", "handle")
 
 
-def _neg(m: re.Match[str]) -> bool:
-    g = m.groupdict()
-    text = m.group(0).lower()
-    return bool(g.get("neg") or g.get("neg2")) or "n't" in text or bool(_NOT_BEEN.search(text))
+def _plain(description: str) -> list[str]:
+    """Markdown stripped, labels dropped, "Gripper: open" lines made sentences."""
+    text = re.sub(r"```\w*|\*\*|__|`", "", description)
+    text = re.sub(r"between\s+the\s+(?:gripper|robot|fingers)\s+and\s+", "with ", text, flags=re.I)
+    lines = []
+    for line in text.splitlines():
+        line = re.sub(r"^\s*(?:#+|[-*•]|\d+[.)])\s+", "", line)
+        line = _LABEL.sub("", line).strip()
+        if not line:
+            continue
+        kv = _KEY_VALUE.match(line)
+        if kv and len(kv.group("k").split()) <= 3:
+            key, value = kv.group("k").strip(), kv.group("v").strip()
+            if _MENTION.search(key) and not re.match(r"(?:the|a|an)\b", value, re.I):
+                line = f"the {key} is {value}"
+            else:
+                line = value
+        lines.append(line)
+    return [s for line in lines for s in _SENTENCE.split(line) if s.strip()]
 
 
-def _np(m: re.Match[str]) -> str | None:
-    g = m.groupdict()
-    return g.get("np") or g.get("np2")
+@dataclass
+class _Mention:
+    kind: str  # grip | robot | obj | place
+    text: str
+    start: int
+    end: int
+
+
+class _Reader:
+    """Carries the last object mentioned across clauses, for pronouns."""
+
+    def __init__(self) -> None:
+        self.last_obj: str | None = None
+        self.last_part: str | None = None
+
+    def mentions(self, clause: str) -> list[_Mention]:
+        out = []
+        for m in _MENTION.finditer(clause):
+            if m.group("grip"):
+                out.append(_Mention("grip", m.group(0), m.start(), m.end()))
+            elif m.group("robot"):
+                out.append(_Mention("robot", m.group(0), m.start(), m.end()))
+            elif m.group("pron"):
+                if m.group(0).lower() == "its":
+                    nxt = clause[m.end() : m.end() + 12].lower()
+                    if not nxt.strip().startswith("handle"):
+                        continue  # "its gripper", "its position": not an object
+                    ref = self.last_part or self.last_obj
+                else:
+                    ref = self.last_obj
+                if ref:
+                    out.append(_Mention("obj", ref, m.start(), m.end()))
+            else:
+                text = normalise_name(m.group("obj"))
+                head = text.split()[-1] if not text.split()[-1].isdigit() else text.split()[-2]
+                if head in ("handle",) and out and out[-1].text == "its":
+                    continue
+                kind = "place" if head in _PLACES else "obj"
+                if head in ("object", "item"):
+                    if not self.last_obj:
+                        continue
+                    text = self.last_obj
+                out.append(_Mention(kind, text, m.start(), m.end()))
+            last = out[-1] if out else None
+            if last is not None and last.kind == "obj" and last.start == m.start():
+                self.last_obj = last.text
+                if any(p in last.text.split() for p in _PARTS):
+                    self.last_part = last.text
+        return out
+
+
+def _neg(text: str) -> bool:
+    return bool(_NEG.search(text))
+
+
+_HEDGE = re.compile(
+    r"\b(?:appears?|seems?|looks?|is\s+likely|happens?)\s+to\s+(?:be\s+)?(?:\w+ly\s+)?$", re.I
+)
+
+
+def _intended(clause: str, at: int) -> bool:
+    """Is the word at `at` something the robot is about to do, not something done?
+
+    "about to grasp", "preparing to press" are intentions; "appears to be closed" is a
+    hedged statement (still a claim) and "has yet to grasp" a negated one.
+    """
+    before = clause[max(0, at - 40) : at]
+    if _YET_TO.search(before) or _HEDGE.search(before):
+        return False
+    return bool(_INTENT.search(before))
+
+
+def _first(ms: list[_Mention], kinds: tuple[str, ...], after: int = -1, before: int = 10**9):
+    for m in ms:
+        if m.kind in kinds and after <= m.start < before:
+            return m
+    return None
+
+
+def _last(ms: list[_Mention], kinds: tuple[str, ...], before: int):
+    found = None
+    for m in ms:
+        if m.kind in kinds and m.end <= before:
+            found = m
+    return found
 
 
 def extract_claims(description: str | None) -> list[Claim]:
     """Every checkable claim in a description, in reading order."""
     if not description:
         return []
+    reader = _Reader()
     claims: list[Claim] = []
-    for sentence in _SENTENCE.split(description):
-        claims.extend(_sentence_claims(sentence.strip()))
+    for sentence in _plain(description):
+        carry: str | None = None  # the subject a noun-less clause continues
+        for clause in _CLAUSE.split(sentence):
+            clause = clause.strip(" .!?")
+            if not clause:
+                continue
+            ms = reader.mentions(clause)
+            if not ms and carry:
+                clause_subject = carry
+                ms = [_Mention("obj" if carry != "gripper" else "grip", carry, -1, -1)]
+            else:
+                clause_subject = None
+            found = _clause_claims(clause, ms)
+            claims.extend(found)
+            head = ms[0] if ms else None
+            if head is not None:
+                carry = (
+                    "gripper"
+                    if head.kind == "grip"
+                    else (head.text if head.kind == "obj" else carry)
+                )
+            if clause_subject:
+                carry = clause_subject
     return claims
 
 
-def _sentence_claims(s: str) -> list[Claim]:
-    found: list[tuple[int, Claim]] = []
-    taken: list[tuple[int, int]] = []
-    for kind, pat in _PATTERNS:
-        for m in pat.finditer(s):
-            span = m.span()
-            if any(a < span[1] and span[0] < b for a, b in taken):
-                continue  # an earlier (more specific) pattern already read these words
-            claim = _to_claim(kind, m)
-            if claim is not None:
-                taken.append(span)
-                found.append((span[0], claim))
-    return [c for _, c in sorted(found, key=lambda x: x[0])]
+def _add(out: list[Claim], claim: Claim) -> None:
+    if not any(c.kind == claim.kind and c.subject == claim.subject for c in out):
+        out.append(claim)
 
 
-def _to_claim(kind: ClaimKind, m: re.Match[str]) -> Claim | None:
-    neg = _neg(m)
-    text = m.group(0)
-    g = m.groupdict()
-    if kind == "gripper":
-        state = "open" if g["state"].lower().startswith("open") else "closed"
-        if neg:
-            state = "closed" if state == "open" else "open"
-        return Claim("gripper", "gripper", state, text)
-    if kind in ("holding_any", "contact_any"):
-        none_word = g["none"].lower()
-        # "holding nothing" / "gripper is empty" assert emptiness; "not holding anything" too
-        empty = (none_word in ("nothing", "empty")) != neg if none_word != "anything" else neg
-        return Claim(kind, None, not empty, text)
-    if kind in ("holding", "contact"):
-        subject = g.get("obj") or _np(m)
-        if not subject or _is_pronoun(subject):
-            return None
-        return Claim(kind, _clean(subject), not neg, text)
-    subject = _np(m)
-    if not subject or _is_pronoun(subject) or "gripper" in subject.lower():
-        return None
-    subject = _clean(subject)
-    if kind == "articulation_pct":
-        frac = float(g["pct"]) / 100.0
-        if g["state"].lower().startswith("clos"):
-            frac = 1.0 - frac
-        return Claim("articulation_pct", subject, min(max(frac, 0.0), 1.0), text)
-    if kind == "articulation":
-        state = "open" if g["state"].lower().startswith("open") else "closed"
-        deg = (g.get("deg") or "").strip().lower()
-        if deg in ("partially", "half", "slightly"):
-            state = "partly_open" if state == "open" else "partly_closed"
-        if neg:
-            state = {"open": "closed", "closed": "open"}.get(state, "unknown")
-        return None if state == "unknown" else Claim("articulation", subject, state, text)
-    if kind == "lifted":
-        how = g["how"].lower()
-        return Claim("lifted", subject, not neg, text) if how else None
-    if kind in ("inside", "on"):
-        target = _clean(g["target"])
-        if kind == "on" and target in ("top",):
-            return None
-        return Claim(kind, subject, (target, not neg), text)
-    if kind == "pressed":
-        return Claim("pressed", subject, not neg, text)
-    return None
+def _clause_claims(clause: str, ms: list[_Mention]) -> list[Claim]:
+    out: list[Claim] = []
+    neg = _neg(clause)
+    objs = [m for m in ms if m.kind == "obj"]
+    parts = [m for m in objs if any(p in m.text.split() for p in _PARTS)]
+    text = clause
+    # holding: "nothing in the gripper", "not holding anything"
+    for m in _EMPTY.finditer(clause):
+        if _intended(clause, m.start()):
+            continue
+        rest_neg = _neg(clause[: m.start()] + " " + clause[m.end() :]) or "n't" in m.group(0)
+        if m.group("any"):
+            _add(out, Claim("holding_any", None, not neg, text))
+        else:
+            _add(out, Claim("holding_any", None, rest_neg, text))
+    for m in _CONTACT_ANY.finditer(clause):
+        nothing = m.group("w").lower() == "nothing"
+        _add(out, Claim("contact_any", None, (not neg) if not nothing else False, text))
+    # gripper open / closed: the state word belongs to the nearest mention before it
+    for pat, state in ((_GRIP_OPEN, "open"), (_GRIP_CLOSED, "closed")):
+        for m in pat.finditer(clause):
+            owner = _last(ms, ("grip", "obj", "robot"), m.start())
+            if owner is None or owner.kind != "grip" or _intended(clause, m.start()):
+                continue
+            if re.match(r"\s+to\s+release", clause[m.end() :]):
+                continue
+            value = state if not neg else ("closed" if state == "open" else "open")
+            _add(out, Claim("gripper", "gripper", value, text))
+    for m in _ADJ_GRIPPER.finditer(clause):
+        state = "open" if m.group("s").lower().startswith("open") else "closed"
+        _add(out, Claim("gripper", "gripper", state, text))
+    # holding: active verbs with their object, passive "X is held", releases
+    for m in _HOLD.finditer(clause):
+        obj = _first(objs, ("obj",), after=m.end() - 1)
+        if obj is None or _intended(clause, m.start()) or obj in parts and "button" in obj.text:
+            continue
+        verb = m.group(0).lower()
+        if re.match(r"(?:lifted|raised|moved|picked)\b", verb) and not re.search(
+            r"\b(?:has|have|had|robot|arm|gripper)\s+(?:\w+\s+)?$", clause[: m.start()]
+        ):
+            continue  # "the can is lifted": a state, read below
+        _add(out, Claim("holding", obj.text, not neg, text))
+        if _LIFT_VERB.match(verb) and obj.text.split()[-1] not in _PARTS:
+            _add(out, Claim("lifted", obj.text, not neg, text))
+    for obj in objs:
+        tail = clause[obj.end :]
+        if _HOLD_PASSIVE.match(tail):
+            _add(out, Claim("holding", obj.text, not neg, text))
+    for m in _RELEASE.finditer(clause):
+        if _intended(clause, m.start()):
+            continue
+        obj = _first(objs, ("obj",), after=m.end() - 1) or _last(ms, ("obj",), m.start())
+        if obj is not None:
+            _add(out, Claim("holding", obj.text, neg, text))
+        else:
+            _add(out, Claim("holding_any", None, neg, text))
+    # contact
+    for m in _CONTACT.finditer(clause):
+        if _intended(clause, m.start()) or _CONTACT_ANY.match(clause, m.start()):
+            continue
+        obj = _first(objs, ("obj",), after=m.end() - 1)
+        if obj is not None:
+            _add(out, Claim("contact", obj.text, not neg, text))
+    # where an object is: lifted, on the table, at its start, in a bin / on a peg, on another
+    subject = objs[0] if objs else None
+    for m in _LIFTED.finditer(clause):
+        owner = _last(ms, ("obj",), m.start()) or subject
+        if owner is None or owner in parts or _intended(clause, m.start()):
+            continue
+        _add(out, Claim("lifted", owner.text, not neg, text))
+    for m in _ON_TABLE.finditer(clause):
+        owner = _last(ms, ("obj",), m.start())
+        if (
+            owner is None
+            or owner in parts
+            or _last(ms, ("grip", "robot", "obj"), m.start()) is not owner
+        ):
+            continue
+        _add(out, Claim("on", owner.text, ("table", not neg), text))
+    for m in _AT_START.finditer(clause):
+        owner = _last(ms, ("obj",), m.start()) or subject
+        if owner is not None:
+            _add(out, Claim("at_start", owner.text, not neg, text))
+    for m in _IN_PLACE.finditer(clause):
+        owner = _last(ms, ("obj",), m.start())
+        target = _first(ms, ("place", "obj"), after=m.end() - 1)
+        if owner is None or target is None or target is owner or _intended(clause, m.start()):
+            continue
+        if owner.text.split()[-1] in ("peg", "post", "rod") + tuple(_PARTS):
+            continue
+        how = m.group("how").lower()
+        positive = not how.startswith("out")
+        if how in ("reach", "reaches", "reached") and _neg(clause):
+            positive = True  # "has not reached the bin": the negation below flips it
+        _add(out, Claim("inside", owner.text, (target.text, positive != neg), text))
+    for m in _ON_OBJ.finditer(clause):
+        owner = _last(ms, ("obj",), m.start())
+        base = _first(ms, ("obj",), after=m.end() - 1)
+        if owner is None or base is None or base is owner or _intended(clause, m.start()):
+            continue
+        if base.text.split()[-1] in ("peg", "post", "rod", "handle") or owner in parts:
+            continue
+        if clause[m.end() : base.start].strip():
+            continue  # "on" must take the object directly
+        _add(out, Claim("on", owner.text, (base.text, not neg), text))
+    # articulated parts and buttons
+    for part in parts:
+        _part_claims(out, clause, part, neg, ms)
+    return out
 
 
-_PRONOUNS = {"it", "this", "that", "them", "something", "object", "item"}
-_ARTICLES = re.compile(r"^(?:the|a|an|its|robot's|their)\s+", re.I)
-
-
-def _is_pronoun(np: str) -> bool:
-    return np.strip().lower() in _PRONOUNS
-
-
-def _clean(name: str) -> str:
-    name = name.strip().lower().replace("_", " ")
-    while True:
-        new = _ARTICLES.sub("", name)
-        if new == name:
-            return name
-        name = new
-
-
-def normalise_name(name: str) -> str:
-    """Lower case, spaces for underscores, no leading article."""
-    return _clean(name)
-
-
-def names_match(said: str, known: str) -> bool:
-    """Does a name from the text refer to a name the simulator uses?
-
-    "can", "soda can", "the can" all match "can"; "bin 2" matches "bin_2" and "bin2" but
-    not "bin 1" (a trailing number must agree); "microwave door" matches "door".
-    """
-    a, b = normalise_name(said), normalise_name(known)
-    if a == b or a.replace(" ", "") == b.replace(" ", ""):
-        return True
-    ta, tb = a.split(), b.split()
-    if not ta or not tb:
-        return False
-    if ta[-1].isdigit() or tb[-1].isdigit():
-        return ta[-2:] == tb[-2:] if len(ta) > 1 and len(tb) > 1 else False
-    return ta[-1] == tb[-1] or a.endswith(" " + b) or b.endswith(" " + a)
+def _part_claims(out: list[Claim], clause: str, part: _Mention, neg: bool, ms) -> None:
+    name = part.text
+    if "button" in name:
+        if _BUTTON_UP.search(clause):
+            _add(out, Claim("pressed", name, neg, clause))
+            return
+        for m in _PRESSED.finditer(clause):
+            if not _intended(clause, m.start()):
+                _add(out, Claim("pressed", name, not neg, clause))
+                return
+        return
+    if name.split()[-1] == "handle":
+        return
+    pct = _PCT.search(clause)
+    words = [
+        (m, st)
+        for pat, st in ((_PART_OPEN, "open"), (_PART_CLOSED, "closed"), (_PART_TURNED, "turned"))
+        for m in pat.finditer(clause)
+    ]
+    words = [
+        (m, st)
+        for m, st in words
+        if not _intended(clause, m.start())
+        and (_last(ms, ("grip", "obj"), m.start()) or part).kind != "grip"
+    ]
+    if not words:
+        return
+    m, state = min(words, key=lambda w: w[0].start())
+    if state == "turned":
+        state = "open"
+    if pct is not None:
+        frac = min(max(float(pct.group("n")) / 100.0, 0.0), 1.0)
+        _add(out, Claim("articulation_pct", name, frac if state == "open" else 1 - frac, clause))
+        return
+    if _HALF.search(clause):
+        _add(out, Claim("articulation_pct", name, 0.5, clause))
+        return
+    if _ALMOST.search(clause):
+        frac = 0.85 if state == "open" else 0.15
+        _add(out, Claim("articulation_pct", name, frac, clause))
+        return
+    if state == "open" and _FULL.search(clause):
+        state = "fully_open"
+    elif state == "open" and _PARTLY.search(clause):
+        state = "partly_open"
+    elif state == "closed" and _PARTLY.search(clause):
+        state = "partly_closed"
+    if neg:
+        state = {
+            "open": "closed",
+            "closed": "open",
+            "fully_open": "not_fully_open",
+        }.get(state, "")
+    if state:
+        _add(out, Claim("articulation", name, state, clause))

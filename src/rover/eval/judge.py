@@ -11,6 +11,7 @@ false one (App. C.2).
 from __future__ import annotations
 
 import asyncio
+import json
 import re
 
 from pydantic import BaseModel, Field
@@ -82,25 +83,86 @@ def facts_to_text(facts: FrameFacts) -> str:
     return "\n".join(lines)
 
 
-_FIELD = re.compile(r"^\W*(true|false)\s+statements?\W*:\s*(.*)$", re.I | re.M)
-_VERDICT = re.compile(r"verdict\W*:\W*(true|false|inconclusive)", re.I)
-_NONE = {"", "none", "n/a", "nothing", "-", "no"}
+_FIELD = re.compile(
+    r"^[\s#>*_\-•]*(?P<kind>true|false)\s+statements?[\s*_]*(?::|$)[\s*_]*(?P<rest>.*)$", re.I
+)
+_VERDICT = re.compile(r"verdict[\s*_\"']*:?[\s*_\"']*(true|false|inconclusive)\b", re.I)
+_BULLET = re.compile(r"^\s*(?:[-*•]|\d+[.)])\s+(.*)$")
+_NONE = {"", "none", "n/a", "na", "nothing", "-", "no", "none.", "[]", "null"}
+
+
+def _items(text: str) -> list[str]:
+    items = [x.strip(" .\"'*`[]") for x in re.split(r";|\s\|\s", text)]
+    return [x for x in items if x.lower().strip(" .") not in _NONE]
+
+
+def _json_reply(text: str) -> FrameJudgement | None:
+    """A reply written as a JSON object (some models do, fenced or not)."""
+    m = re.search(r"\{.*\}", text, re.S)
+    if not m:
+        return None
+    try:
+        body = json.loads(m.group(0))
+    except ValueError:
+        return None
+    if not isinstance(body, dict):
+        return None
+    lists: dict[str, list[str]] = {"true": [], "false": []}
+    seen, verdict = set(), None
+    for key, value in body.items():
+        k = str(key).lower()
+        kind = "true" if k.startswith("true") else ("false" if k.startswith("false") else None)
+        if kind and "statement" in k:
+            seen.add(kind)
+            vals = value if isinstance(value, list) else [value]
+            lists[kind] = [str(v) for v in vals if v and str(v).lower() not in _NONE]
+        elif k == "verdict" and str(value).lower() in ("true", "false", "inconclusive"):
+            verdict = str(value).lower()
+    if not seen and verdict is None:
+        return None
+    if seen == {"true", "false"}:
+        verdict = frame_verdict(len(lists["true"]), len(lists["false"]))
+    verdict = verdict or "inconclusive"
+    return FrameJudgement(verdict, lists["true"], lists["false"], text.strip()[:500])  # type: ignore[arg-type]
 
 
 def parse_judge_reply(text: str) -> FrameJudgement:
-    """Read a judge reply; the statement lists decide, the Verdict line is a fallback."""
+    """Read a judge reply: "True statements: ..." / "False statements: ..." / "Verdict: ...".
+
+    Tolerates markdown (bold labels, headings), prose around the fields, lists written as
+    bullets under their label, and JSON. The two statement lists decide the verdict by
+    App. C.2's rule when both are there; otherwise the Verdict line does; a reply with
+    neither (cut off, or no format at all) is inconclusive.
+    """
+    text = text or ""
     lists: dict[str, list[str]] = {"true": [], "false": []}
-    seen = False
-    for m in _FIELD.finditer(text or ""):
-        seen = True
-        items = [x.strip(" .\"'*") for x in m.group(2).split(";")]
-        lists[m.group(1).lower()] = [x for x in items if x.lower() not in _NONE]
-    if seen:
+    seen: set[str] = set()
+    current: str | None = None
+    for raw in text.splitlines():
+        line = raw.replace("**", "").replace("__", "")
+        m = _FIELD.match(line)
+        if m:
+            current = m.group("kind").lower()
+            seen.add(current)
+            lists[current] = _items(m.group("rest"))
+            continue
+        b = _BULLET.match(line)
+        if current and b:
+            lists[current] += _items(b.group(1))
+            continue
+        if line.strip():
+            current = None
+    v = _VERDICT.search(text.replace("**", ""))
+    if seen == {"true", "false"}:
         verdict = frame_verdict(len(lists["true"]), len(lists["false"]))
+    elif v:
+        verdict = v.group(1).lower()
     else:
-        m = _VERDICT.search(text or "")
-        verdict = m.group(1).lower() if m else "inconclusive"  # type: ignore[assignment]
-    return FrameJudgement(verdict, lists["true"], lists["false"], (text or "").strip()[:500])
+        parsed = _json_reply(text)
+        if parsed is not None:
+            return parsed
+        verdict = "false" if lists["false"] else "inconclusive"
+    return FrameJudgement(verdict, lists["true"], lists["false"], text.strip()[:500])  # type: ignore[arg-type]
 
 
 def _frames(trace: Trace, episode: Episode) -> list[tuple[int, int, str | None, FrameFacts | None]]:

@@ -13,8 +13,9 @@ import re
 from dataclasses import dataclass, field
 
 from rover.episode import QAItem
-from rover.eval.claims import extract_claims, names_match
-from rover.eval.rule_judge import CLOSED_MAX, FULLY_OPEN_MIN, OPEN_MIN
+from rover.eval.claim_names import names_match, normalise_name
+from rover.eval.claims import extract_claims
+from rover.eval.rule_judge import CLOSED_MAX, FULLY_OPEN_MIN, OPEN_MIN, _target
 
 _DROP_WORDS = re.compile(r"\b(drop(?:s|ped|ping)?|fell|falls|falling|slip(?:s|ped|ping)?)\b", re.I)
 _LIFT_WORDS = re.compile(
@@ -33,14 +34,31 @@ class Asserted:
     not_held: set[str] = field(default_factory=set)
     touched: set[str] = field(default_factory=set)
     lifted: dict[str, bool] = field(default_factory=dict)
-    inside: dict[str, str] = field(default_factory=dict)
+    inside: dict[str, str] = field(default_factory=dict)  # object -> place, as said
     on: dict[str, str] = field(default_factory=dict)
-    parts: dict[str, float] = field(default_factory=dict)  # articulation fraction 0..1
+    # articulation as the range of fractions the words allow: "closed" (0, 0.1),
+    # "partly open" (0.1, 0.9), "fully open" (0.9, 1), "about 40% open" (0.4, 0.4)
+    parts: dict[str, tuple[float, float]] = field(default_factory=dict)
     pressed: dict[str, bool] = field(default_factory=dict)
 
 
+_STATE_RANGE = {
+    "open": (OPEN_MIN + 1e-6, 1.0),
+    "closed": (0.0, CLOSED_MAX),
+    "fully_open": (FULLY_OPEN_MIN, 1.0),
+    "not_fully_open": (0.0, FULLY_OPEN_MIN - 1e-6),
+    "partly_open": (OPEN_MIN + 1e-6, FULLY_OPEN_MIN - 1e-6),
+    "partly_closed": (CLOSED_MAX + 1e-6, FULLY_OPEN_MIN - 1e-6),
+}
+
+
+def _resolve_place(said: str, obj: str, task: str | None) -> str:
+    """ "the target bin" -> the task's bin for `obj`; other places as said."""
+    return _target(said, obj, task) or said
+
+
 def asserted_states(descriptions: list[str | None], task: str | None = None) -> list[Asserted]:
-    """One `Asserted` per frame position."""
+    """One `Asserted` per frame position (`task` says which bin "the target bin" is)."""
     out = []
     for d in descriptions:
         a = Asserted(text=d or "")
@@ -56,16 +74,21 @@ def asserted_states(descriptions: list[str | None], task: str | None = None) -> 
                 a.touched.add(s)
             elif c.kind == "lifted":
                 a.lifted[s] = bool(c.value)
+            elif c.kind == "at_start" and c.value:
+                a.lifted.setdefault(s, False)
             elif c.kind in ("inside", "on"):
                 target, positive = c.value  # type: ignore[misc]
-                if positive:
-                    (a.inside if c.kind == "inside" else a.on)[s] = target
+                if normalise_name(target) in ("table", "tabletop", "surface", "counter"):
+                    if positive:
+                        a.lifted.setdefault(s, False)
+                elif positive:
+                    place = _resolve_place(target, s, task) if c.kind == "inside" else target
+                    (a.inside if c.kind == "inside" else a.on)[s] = place
             elif c.kind == "articulation_pct":
-                a.parts[s] = float(c.value)  # type: ignore[arg-type]
-            elif c.kind == "articulation":
-                a.parts[s] = {"open": 1.0, "closed": 0.0, "partly_open": 0.5, "partly_closed": 0.5}[
-                    str(c.value)
-                ]
+                v = float(c.value)  # type: ignore[arg-type]
+                a.parts[s] = (v, v)
+            elif c.kind == "articulation" and str(c.value) in _STATE_RANGE:
+                a.parts[s] = _STATE_RANGE[str(c.value)]
             elif c.kind == "pressed":
                 a.pressed[s] = bool(c.value)
         out.append(a)
@@ -186,15 +209,16 @@ def _event_here(ev: str, obj: str, target: str | None, a: Asserted, was_held: bo
             pressed = _get(a.pressed, "button")
         if pressed is not None:
             return pressed is (ev == "turn_on")
-    value = _get(a.parts, obj)
-    if not isinstance(value, float):
+    rng = _get(a.parts, obj)
+    if not isinstance(rng, tuple):
         return False
+    lo, hi = rng
     if ev in ("open_start", "turn_start"):
-        return value > OPEN_MIN
+        return lo > OPEN_MIN
     if ev == "close_start":
-        return value < FULLY_OPEN_MIN
+        return hi < FULLY_OPEN_MIN
     if ev in ("open_finish", "turn_on", "turn_finish"):
-        return value >= FULLY_OPEN_MIN
+        return lo >= FULLY_OPEN_MIN
     if ev in ("close_finish", "turn_off"):
-        return value <= CLOSED_MAX
+        return hi <= CLOSED_MAX
     return False

@@ -14,11 +14,13 @@ at least `FULLY_OPEN_MIN`.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Literal
 
 from rover.episode import FrameFacts
-from rover.eval.claims import Claim, extract_claims, names_match
+from rover.eval.claim_names import names_match, normalise_name, resolve
+from rover.eval.claims import Claim, extract_claims
 
 PCT_TOLERANCE = 0.15
 OPEN_MIN = 0.1
@@ -57,7 +59,7 @@ def judge_description(
     true_c: list[str] = []
     false_c: list[str] = []
     for claim in extract_claims(description):
-        ok = check_claim(claim, facts)
+        ok = check_claim(claim, facts, task)
         if ok is True:
             true_c.append(claim.describe())
         elif ok is False:
@@ -77,19 +79,36 @@ def known_names(facts: FrameFacts) -> list[str]:
     names += list(facts.pressed)
     if facts.holding:
         names.append(facts.holding)
-    return names
+    return list(dict.fromkeys(names))
 
 
-def _resolve(name: str | None, candidates: list[str]) -> str | None:
-    if not name:
+def goal_of(task: str | None, obj: str) -> str | None:
+    """The bin the task wants `obj` in: "... put the milk in bin 1 and the can in bin 4"."""
+    if not task:
         return None
-    for c in candidates:
-        if names_match(name, c):
-            return c
+    obj_words = r"\s+".join(re.escape(w) for w in normalise_name(obj).split())
+    near = rf"\b{obj_words}\s+(?:\w+\s+){{0,3}}?(?:in|into)\s+(bin\s*\d+)"
+    m = re.search(near, task, re.I) or re.search(r"\b(?:in|into)\s+(bin\s*\d+)", task, re.I)
+    return m.group(1).lower() if m else None
+
+
+_GOAL_WORDS = re.compile(r"\b(?:target|goal|correct|destination|other|second)\b")
+_START_WORDS = re.compile(r"\b(?:start|starting|original|initial|first)\b")
+
+
+def _target(said: str, obj: str, task: str | None) -> str | None:
+    """The facts' name for where the text says an object is ("the target bin" -> "bin 4")."""
+    said = normalise_name(said)
+    if re.search(r"\d", said) or said.split()[-1] in ("peg", "post", "rod"):
+        return "peg" if said.split()[-1] in ("post", "rod") else said
+    if _START_WORDS.search(said):
+        return "start bin"
+    if _GOAL_WORDS.search(said) or said in ("bin", "bins"):
+        return goal_of(task, obj)
     return None
 
 
-def check_claim(claim: Claim, facts: FrameFacts) -> bool | None:
+def check_claim(claim: Claim, facts: FrameFacts, task: str | None = None) -> bool | None:
     """True / False when the facts decide the claim, None when they cannot."""
     k = claim.kind
     if k == "gripper":
@@ -100,22 +119,24 @@ def check_claim(claim: Claim, facts: FrameFacts) -> bool | None:
         return bool(facts.contacts) == claim.value
     known = known_names(facts)
     if k == "holding":
-        held = facts.holding is not None and names_match(claim.subject or "", facts.holding)
+        name = resolve(claim.subject, known)
+        held = facts.holding is not None and name == facts.holding
         if claim.value:
             if held:
                 return True
             # holding something else (or nothing): false if we know the object at all
-            return False if facts.holding is None or _resolve(claim.subject, known) else None
-        return not held
+            return False if facts.holding is None or name is not None else None
+        return None if name is None and facts.holding is not None else not held
     if k == "contact":
-        if _resolve(claim.subject, list(facts.contacts)) is not None:
+        name = resolve(claim.subject, known)
+        if name is not None and name in facts.contacts:
             return bool(claim.value)
         # not touching it: decided when we know the object, or the gripper touches nothing
-        if _resolve(claim.subject, known) is not None or not facts.contacts:
+        if name is not None or not facts.contacts:
             return not claim.value
         return None
-    if k in ("lifted", "inside", "on"):
-        return _check_object(claim, facts)
+    if k in ("lifted", "inside", "on", "at_start"):
+        return _check_object(claim, facts, task)
     if k in ("articulation", "articulation_pct"):
         return _check_articulation(claim, facts)
     if k == "pressed":
@@ -123,25 +144,37 @@ def check_claim(claim: Claim, facts: FrameFacts) -> bool | None:
     return None
 
 
-def _check_object(claim: Claim, facts: FrameFacts) -> bool | None:
-    name = _resolve(claim.subject, list(facts.objects))
+def _check_object(claim: Claim, facts: FrameFacts, task: str | None) -> bool | None:
+    name = resolve(claim.subject, list(facts.objects))
     if name is None:
         return None
     obj = facts.objects[name]
     if claim.kind == "lifted":
         return obj.lifted == claim.value
-    target, positive = claim.value  # type: ignore[misc]
-    where = obj.inside if claim.kind == "inside" else obj.on
-    if claim.kind == "on" and where is None:
-        # resting on something contradicts being lifted; otherwise the facts are silent
-        return (not positive) if obj.lifted and positive else None
-    if where is None:
-        return not positive
-    return names_match(target, where) == positive
+    if claim.kind == "at_start":
+        at_start = not obj.lifted and obj.inside in (None, "start bin") and facts.holding != name
+        return at_start == claim.value
+    said, positive = claim.value  # type: ignore[misc]
+    if claim.kind == "on" and normalise_name(said) in ("table", "tabletop", "surface", "counter"):
+        # resting on the table = not lifted and in no bin; in a bin the facts are silent
+        if obj.lifted or (obj.on is not None and obj.on != "table"):
+            return not positive
+        return positive if obj.inside is None else None
+    if claim.kind == "on":
+        base = resolve(said, list(facts.objects))
+        if base is None:
+            return None
+        return (obj.on == base) == positive
+    target = _target(said, name, task)
+    where = [w for w in (obj.inside, obj.on) if w]
+    if target is None:
+        # "in the bin" with no goal known: only "not in any bin yet" is decided
+        return (not positive) if not where else None
+    return any(names_match(target, w) for w in where) == positive
 
 
 def _articulation_value(claim: Claim, facts: FrameFacts) -> float | None:
-    name = _resolve(claim.subject, list(facts.articulations))
+    name = resolve(claim.subject, list(facts.articulations))
     return None if name is None else float(facts.articulations[name])
 
 
@@ -151,21 +184,18 @@ def _check_articulation(claim: Claim, facts: FrameFacts) -> bool | None:
         return None
     if claim.kind == "articulation_pct":
         return abs(value - float(claim.value)) <= PCT_TOLERANCE  # type: ignore[arg-type]
-    state = claim.value
-    if state == "open":
-        fully = "fully" in claim.text.lower() or "completely" in claim.text.lower()
-        return value >= FULLY_OPEN_MIN if fully else value > OPEN_MIN
-    if state == "closed":
-        return value <= CLOSED_MAX
-    if state == "partly_open":
-        return OPEN_MIN < value < FULLY_OPEN_MIN
-    if state == "partly_closed":
-        return CLOSED_MAX < value < FULLY_OPEN_MIN
-    return None
+    return {
+        "open": value > OPEN_MIN,
+        "closed": value <= CLOSED_MAX,
+        "fully_open": value >= FULLY_OPEN_MIN,
+        "not_fully_open": value < FULLY_OPEN_MIN,
+        "partly_open": OPEN_MIN < value < FULLY_OPEN_MIN,
+        "partly_closed": CLOSED_MAX < value < FULLY_OPEN_MIN,
+    }.get(str(claim.value))
 
 
 def _check_pressed(claim: Claim, facts: FrameFacts) -> bool | None:
-    if _resolve(claim.subject, list(facts.pressed)) is not None:
+    if resolve(claim.subject, list(facts.pressed)) is not None:
         return bool(claim.value)
     value = _articulation_value(claim, facts)
     if value is not None:

@@ -26,6 +26,7 @@ from pathlib import Path
 from rover.episode import FrameFacts
 from rover.eval.agreement import CORPUS_VERSION, banks
 from rover.eval.agreement.handwritten import FRAME_CASES as HAND_FRAMES
+from rover.eval.agreement.handwritten import FRESH_CASES
 from rover.eval.rule_judge import frame_verdict
 
 STYLES = ("gpt-4o", "gemini-2.5", "qwen2.5-vl")
@@ -207,7 +208,9 @@ def render(stmts: list[tuple], style: str, rng: random.Random) -> str:
     # pronouns: a clause about the same object as the one before says "it"
     for i in range(1, len(stmts)):
         subj = stmts[i][2]
-        if subj and subj == stmts[i - 1][2] and rng.random() < 0.6:
+        prev_objs = {x for a in stmts[i - 1][1] for x in a[1:] if isinstance(x, str)}
+        prev_objs &= set(banks.ALIASES)
+        if subj and subj == stmts[i - 1][2] and prev_objs <= {subj} and rng.random() < 0.6:
             m = re.match(r"the ([\w\s'-]+?) (is|has|sits|rests|remains|appears)\b", texts[i])
             agent = re.search(r"gripper|robot|arm|finger", m.group(1)) if m else True
             if m and not agent and m.group(1) in texts[i - 1]:
@@ -314,7 +317,7 @@ _PART_RANGE = {
 
 def _claimed_range(atom: tuple) -> tuple[float, float]:
     if atom[2] == "pct":
-        return atom[3] - 0.05, atom[3] + 0.05
+        return atom[3], atom[3]
     return _PART_RANGE[atom[2]]
 
 
@@ -454,7 +457,8 @@ def hand_cases(episodes) -> list[dict]:
     """The hand-written cases with their frame's task, family and facts filled in."""
     by_id = {ep.id: ep for ep in episodes}
     out = []
-    for c in HAND_FRAMES:
+    fresh = [{**c, "style": "handwritten-fresh", "fresh": True} for c in FRESH_CASES]
+    for c in HAND_FRAMES + fresh:
         ep = by_id[c["episode"]]
         facts = ep.truth.facts[c["frame"]].model_dump(mode="json")
         out.append({**c, "task": ep.task, "family": ep.task_group, "facts": facts})
@@ -464,9 +468,12 @@ def hand_cases(episodes) -> list[dict]:
 def assign_splits(cases: list[dict], prefix: str, rng: random.Random) -> list[dict]:
     order = list(range(len(cases)))
     rng.shuffle(order)
-    half = set(order[: len(order) // 2])
+    fresh = {id(c) for c in cases if c.get("fresh")}
+    pool = [i for i in order if id(cases[i]) not in fresh]
+    half = set(pool[: len(cases) // 2])
     out = []
     for i, c in enumerate(cases):
+        c = {k: v for k, v in c.items() if k != "fresh"}
         out.append({"id": f"{prefix}{i:04d}", "split": "dev" if i in half else "heldout", **c})
     return out
 
