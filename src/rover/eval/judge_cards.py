@@ -26,6 +26,7 @@ KINDS = ("judge", "answerer")
 _RULE_KEYS = {"judge": "rule_judge", "answerer": "rule_answerer"}
 _LLM_KEYS = {"judge": "llm_judge_scripted", "answerer": "llm_answerer_scripted"}
 _OFF = {"", "none", "off", "skip"}
+FRESH_GROUP = "style:handwritten-fresh"
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,10 @@ class JudgeCard:
     n: int = 0
     corpus: str = ""  # corpus version the number was measured on
     note: str = ""
+    # agreement on the held-out descriptions written by hand in fresh words (not from the
+    # phrase banks the rules were developed beside): the harder, more honest number
+    fresh_agreement: float | None = None
+    fresh_n: int = 0
 
     def line(self) -> str:
         """One line for summaries: name and agreement (or why there is none)."""
@@ -51,8 +56,10 @@ class JudgeCard:
         if self.agreement is None:
             return f"{what}: {self.name} — agreement not measured. {self.note}".strip()
         agree = f"{100 * self.agreement:.1f}% agreement with labels on {self.n} held-out cases"
-        tail = f" ({self.note})" if self.note else ""
-        return f"{what}: {self.name} — {agree}, corpus {self.corpus}{tail}"
+        if self.fresh_agreement is not None:
+            agree += f" ({100 * self.fresh_agreement:.1f}% on the {self.fresh_n} in fresh words)"
+        tail = f"; {self.note}" if self.note else ""
+        return f"{what}: {self.name} — {agree}, corpus v{self.corpus}{tail}"
 
 
 @cache
@@ -87,7 +94,17 @@ def judge_card(kind: str, spec: str = "rule") -> JudgeCard | None:
         name = "rule judge" if kind == "judge" else "rule QA answerer"
         if entry is None:
             return JudgeCard(kind, "rule", name, None, note="run benchmarks/judge_agreement.py")
-        return JudgeCard(kind, "rule", name, float(entry["agreement"]), int(entry["n"]), corpus, "")
+        fresh = entry.get("by_group", {}).get(FRESH_GROUP)
+        return JudgeCard(
+            kind,
+            "rule",
+            name,
+            float(entry["agreement"]),
+            int(entry["n"]),
+            corpus,
+            fresh_agreement=float(fresh["agreement"]) if fresh else None,
+            fresh_n=int(fresh["n"]) if fresh else 0,
+        )
     scripted = _entry(_LLM_KEYS[kind])
     note = "its agreement depends on the model; the paper measured 97.5% for GPT-4.5."
     if scripted is not None:
