@@ -38,9 +38,16 @@ def generate_command(
         Path | None,
         typer.Option("--source-hdf5", help="robomimic/RoboCasa HDF5 to use as expert demos."),
     ] = None,
+    progress_form: Annotated[
+        str,
+        typer.Option(
+            "--progress-form",
+            help="Progress: 'rover' (documented departures from Sec. 4.2) or 'paper'.",
+        ),
+    ] = "rover",
 ) -> None:
     """Generate perturbed robosuite videos with ground-truth progress, facts, events and QA."""
-    from rover.sim.generate import GenerateConfig, generate
+    from rover.sim.generate import MAX_FRAMES, GenerateConfig, generate
     from rover.sim.render import check_views
     from rover.sim.tasks import get_task
 
@@ -55,11 +62,17 @@ def generate_command(
         raise InputError("--per-level, --workers and --demos must be >= 1, --size >= 16")
     if size > MAX_SIZE:
         raise InputError(f"--size must be at most {MAX_SIZE} px, got {size}")
-    if frames < 0:
-        raise InputError(f"--frames must be 0 (the task's default) or positive, got {frames}")
+    if not 0 <= frames <= MAX_FRAMES:
+        raise InputError(
+            f"--frames must be 0 (the task's default) or 1..{MAX_FRAMES}, got {frames}"
+        )
+    if not view_list:
+        raise InputError("--views is empty; give e.g. left,wrist")
     _check_levels(task_list, _split(levels))
     if source_hdf5 is not None and not source_hdf5.exists():
         raise InputError(f"--source-hdf5 {source_hdf5}: no such file")
+    if progress_form not in ("rover", "paper"):
+        raise InputError(f"--progress-form must be 'rover' or 'paper', got {progress_form!r}")
     cfg = GenerateConfig(
         tasks=task_list,
         per_level=per_level,
@@ -70,6 +83,7 @@ def generate_command(
         seed=seed,
         demos=demos,
         source_hdf5=str(source_hdf5) if source_hdf5 else None,
+        progress_form=progress_form,  # type: ignore[arg-type]
     )
     check_output_dir(out, "--out", marker="dataset.json")
     _check_resume(out, cfg)
@@ -95,6 +109,10 @@ def generate_command(
         written = generate(cfg, out, workers=workers, on_progress=on_progress)
     took = time.perf_counter() - start
     console.print(f"wrote {len(written)} episodes to {esc(out)} in {took:.1f}s")
+    from rover.commands.validate import run_audit
+
+    if run_audit(out, console) > 0:  # the same audit as `rover validate OUT`
+        raise typer.Exit(1)
 
 
 # settings that change what an episode looks like: a dataset never mixes two values
@@ -106,8 +124,10 @@ def _check_levels(tasks: list[str], wanted: list[str]) -> None:
     from rover.sim.tasks import get_task
 
     for w in wanted:
-        if not w.isdigit():
+        if w in ("all", "last"):
             continue
+        if not w.isdigit():
+            raise InputError(f"--levels: {w!r} is not a level number, 'last' or 'all'")
         for t in tasks:
             have = sorted(lv.level for lv in get_task(t).levels)
             if int(w) not in have:
@@ -124,6 +144,8 @@ def _check_resume(out: Path, cfg) -> None:
     if not (out / DATASET_FILE).exists():
         return
     before = read_dataset_info(out).generator
+    if not before:
+        raise InputError(f"{out} holds a dataset rover generate did not make; use a new --out")
     now = cfg.model_dump(mode="json")
     differ = [k for k in _EPISODE_SETTINGS if k in before and before.get(k) != now.get(k)]
     if differ:

@@ -124,7 +124,9 @@ class ReplayBackend(BaseBackend):
         self._served: dict[str, int] = defaultdict(int)
         self._lock = threading.Lock()
         self._read()
-        models = {e["model"] for entries in self._by_key.values() for e in entries}
+        if not self._by_key:
+            raise InputError(f"replay: {self.path} holds no recorded completions")
+        models = {str(e.get("model")) for entries in self._by_key.values() for e in entries}
         self.recorded_models = sorted(models)
 
     def _read(self) -> None:

@@ -66,7 +66,8 @@ ConcurrencyOpt = Annotated[
     int | None, typer.Option("--concurrency", help="VLM calls in flight at once (default 8).")
 ]
 TimeoutOpt = Annotated[
-    float | None, typer.Option("--timeout", help="Seconds per VLM call (default 120).")
+    float | None,
+    typer.Option("--timeout", help="Seconds per VLM call attempt (default 60; 10 to connect)."),
 ]
 MaxRetriesOpt = Annotated[
     int | None,
@@ -133,6 +134,9 @@ _RENAMES = {
 }
 
 
+_OPTION_OF = {field: option for option, field in _RENAMES.items()}
+
+
 def config_from_options(**options: Any) -> BackendConfig:
     """A BackendConfig from command options; None (and False for flags) means "default".
 
@@ -149,4 +153,5 @@ def config_from_options(**options: Any) -> BackendConfig:
     except ValidationError as exc:
         err = exc.errors()[0]
         where = ".".join(str(x) for x in err["loc"]) or "option"
+        where = _OPTION_OF.get(where, where)  # name the option the user typed, not the field
         raise InputError(f"--{where.replace('_', '-')}: {err['msg']}") from None

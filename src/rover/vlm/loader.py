@@ -107,6 +107,9 @@ def load_vlm(spec: str, config: BackendConfig | None = None) -> VLM:
         vlm = ReplayBackend(model, config)
     else:
         vlm = _load_oracle(config)
+    open_cache = getattr(vlm, "_response_cache", None)
+    if open_cache is not None:
+        open_cache()  # an unusable --cache fails now, before any decoding or paid call
     if config.record is not None:
         from rover.vlm.cassette import CassetteWriter, RecordingVLM
 
