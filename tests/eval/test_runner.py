@@ -86,7 +86,7 @@ def test_sweeps_make_one_variant_per_combination(tmp_path: Path, make_dataset) -
     assert len(ids) == 12
     assert "rover__b=oracle__f=6__w=6__v=wrist" in ids
     assert "gvl__b=oracle__f=12__w=na__v=left" in ids
-    assert len({v["label"] for v in m["variants"]}) == 12
+    assert len({(v["label"], v["view"]) for v in m["variants"]}) == 12  # views: a column
     trace = json.loads(
         (out / "traces" / "ep0" / "rover__b=oracle__f=6__w=6__v=wrist.json").read_text()
     )

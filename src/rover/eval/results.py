@@ -182,6 +182,7 @@ def compute_metrics(rundir: RunDir, config: dict[str, Any]) -> dict[str, Any]:
                     qa_abs_dt=sc["abs_distance"],
                     qa_n=sc["qa_n"],
                     qa_unreadable=sc["unreadable"],
+                    qa_dts=signed_distances(qa.answers),
                 )
                 answers.setdefault(v.id, []).extend((row, a) for a in qa.answers)
             for k, flag in video_errors(trace, ep, judg).items():
@@ -190,7 +191,10 @@ def compute_metrics(rundir: RunDir, config: dict[str, Any]) -> dict[str, Any]:
                 e = errors[(eid, v.id)]
                 row["stage_error"] = f"{e.get('stage')}: {e.get('error')}"
             rows.append(row)
-    multi_dataset = len({r.get("dataset") for r in rows}) > 1
+    # App. L's per-dataset table: several datasets, or real videos scored against frame number
+    multi_dataset = len({r.get("dataset") for r in rows}) > 1 or any(
+        r.get("progress_source") == "frame_number" for r in rows
+    )
     out = {
         "schema_version": METRICS_SCHEMA,
         "variants": [v.model_dump(mode="json") for v in variants],

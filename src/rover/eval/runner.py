@@ -239,6 +239,10 @@ class Runner:
             meta = Episode.model_validate_json(saved.read_text())
             return meta, meta
         meta, loaded = load_for_variants(ref, pending)
+        from rover.run.store import write_thumbs
+
+        for name, arr in loaded.views.items():  # the run keeps the frames a report shows
+            write_thumbs(self.rundir.root, ref.id, name, arr, loaded.frame_indices)
         encodings: dict[str, ImageEncoding] = {}
         for v in pending:
             enc = getattr(self.vlms[v.backend], "image_encoding", None) or ImageEncoding()

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rover.eval.aggregate import fmt_mean_se
+from rover.methods.info import display_name
 
 MAIN_COLUMNS = [
     # (header, source, metric, digits); every column is a per-video mean ± SE, and
@@ -86,10 +87,11 @@ def main_rows(metrics: dict[str, Any], compact: bool = False) -> tuple[list[str]
             for v in metrics.get("variants", [])
         )
     ]
-    headers = ["Method"] + [c[0] for c in columns] + ["n"]
+    with_view = views_vary(metrics)
+    headers = ["Method"] + (["View"] if with_view else []) + [c[0] for c in columns] + ["n"]
     rows = []
     for v in metrics.get("variants", []):
-        cells = [v["label"] or v["id"]]
+        cells = [v["label"] or v["id"]] + ([v["view"] or "own"] if with_view else [])
         n = 0
         for _, _src, metric, digits in columns:
             a = idx.get((v["id"], metric, "all", "all"))
@@ -103,12 +105,26 @@ def main_rows(metrics: dict[str, Any], compact: bool = False) -> tuple[list[str]
     return headers, rows
 
 
+def views_vary(metrics: dict[str, Any]) -> bool:
+    """True when the run sweeps camera views (then tables carry a View column)."""
+    return len({v.get("view") for v in metrics.get("variants", [])}) > 1
+
+
+def variant_names(metrics: dict[str, Any]) -> dict[str, str]:
+    """Variant id -> its name in column headers (the view added when views vary)."""
+    with_view = views_vary(metrics)
+    return {
+        v["id"]: (v["label"] or v["id"]) + (f" · {v['view'] or 'own'} view" if with_view else "")
+        for v in metrics.get("variants", [])
+    }
+
+
 def pooled_rows(metrics: dict[str, Any]) -> tuple[list[str], list[list[str]]] | None:
     """Secondary QA table: every question of a variant pooled (no SE); None without QA."""
     rows = [q for q in metrics.get("qa_pooled", []) if q["by"] == "all" and q.get("qa_n")]
     if not rows:
         return None
-    labels = {v["id"]: v["label"] or v["id"] for v in metrics.get("variants", [])}
+    labels = variant_names(metrics)
     body = [
         [labels.get(q["variant"], q["variant"])]
         + [_fmt(q.get(k), None, d) if d else str(q.get(k) or 0) for _, k, d in POOLED_COLUMNS]
@@ -137,7 +153,8 @@ def pivot(
     ]
     groups = sorted({a["group"] for a in aggs}, key=_group_key)
     cell = {(a["variant"], a["group"]): a for a in aggs}
-    headers = [LEVEL_NAMES.get(by, by)] + [v["label"] or v["id"] for v in variants]
+    names = variant_names(metrics)
+    headers = [LEVEL_NAMES.get(by, by)] + [names[v["id"]] for v in variants]
     rows = []
     for g in groups:
         row = [str(g)]
@@ -174,7 +191,7 @@ def sweep_pivot(
 
     def column(v: dict[str, Any]) -> str:
         extra = [f"{_SHORT[k]}={v[k]}" for k in others if v[k] is not None]
-        return v["method"] + (f" [{', '.join(extra)}]" if extra else "")
+        return display_name(v["method"]) + (f" [{', '.join(extra)}]" if extra else "")
 
     idx = _agg_index(metrics)
     cols = list(dict.fromkeys(column(v) for v in variants if v[dim] is not None))
@@ -254,7 +271,7 @@ def run_tables(metrics: dict[str, Any]) -> list[Table]:
     """Every table of the run, in reading order (the main table first)."""
     from rover.eval.results import inconclusive_warnings
 
-    labels = {v["id"]: v["label"] or v["id"] for v in metrics.get("variants", [])}
+    labels = variant_names(metrics)
     warnings = [
         f"{labels.get(vid, vid)}: the judge left {share:.0f}% of its frames inconclusive, so "
         "its error rate rests on fewer than 70% of its frames."
@@ -322,7 +339,7 @@ def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
 
 def _cost_table(metrics: dict[str, Any]) -> Table | None:
     rows: dict[tuple, dict[str, Any]] = {}
-    labels = {v["id"]: v["label"] for v in metrics.get("variants", [])}
+    labels = variant_names(metrics)
     for c in metrics.get("cost", []):
         rows.setdefault((c["variant"], c["frames"]), {})[c["metric"]] = c
     if not rows:
@@ -348,7 +365,7 @@ def _error_table(metrics: dict[str, Any]) -> Table | None:
     if not rows:
         return None
     variants = list(dict.fromkeys(r["variant"] for r in rows))
-    labels = {v["id"]: v["label"] for v in metrics.get("variants", [])}
+    labels = variant_names(metrics)
     names = {
         "incorrect_subtask": "Incorrect subtasks",
         "redundant_subtask": "Redundant subtasks",

@@ -102,20 +102,20 @@ def expand_variants(
 
 
 def _label(variants: list[Variant]) -> None:
-    """Method name plus only the settings that vary within this run."""
-    varying = {
-        k
-        for k in ("backend", "frames", "window", "view")
-        if len({getattr(v, k) for v in variants if k != "window" or v.window is not None}) > 1
-    }
-    short = {"backend": "b", "frames": "f", "window": "w", "view": "v"}
+    """Display name plus the settings that vary within this run ('ROVER (window 6) · 30
+    frames'). The view is not part of it: views are a column of their own in every table."""
+    backends = {v.backend for v in variants}
+    frames = {v.frames for v in variants}
     for v in variants:
-        parts = []
-        for k in ("backend", "frames", "window", "view"):
-            val = getattr(v, k)
-            if k in varying and val is not None:
-                parts.append(f"{short[k]}={val}")
-        v.label = v.method + (f" [{', '.join(parts)}]" if parts else "")
+        info = method_info(v.method)
+        name = info.display
+        if v.window is not None and v.window != info.default_window:
+            name += f" (window {v.window})"
+        if len(backends) > 1:
+            name += f" [{v.backend}]"
+        if len(frames) > 1:
+            name += f" · {v.frames} frames" if v.frames else " · all frames"
+        v.label = name
 
 
 def parse_int_list(text: str | None, option: str, minimum: int = 1) -> list[int | None]:
