@@ -12,8 +12,9 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from rover.console import esc, make_console
+from rover.console import esc, line, make_console
 from rover.errors import InputError
+from rover.paths import check_output_dir
 from rover.vlm import cli_options as vo
 
 HELP = "Evaluate reasoning methods on a dataset: progress, frame reasoning, video QA, cost."
@@ -53,6 +54,7 @@ def eval_command(
         str,
         typer.Option(
             "--backend",
+            "--vlm",
             help="VLM spec(s), comma-separated (" + vo.VLM_HELP.removeprefix("VLM spec: ") + ")",
         ),
     ] = "oracle",
@@ -138,6 +140,7 @@ def eval_command(
         raise InputError(f"--concurrency must be at least 1, got {concurrency}")
     if calls_in_flight is not None and calls_in_flight < 1:  # 0 is not "unset"
         raise InputError(f"--calls-in-flight must be at least 1, got {calls_in_flight}")
+    check_output_dir(out, "--out", allow_nonempty=True)  # the run directory says if it is a run
     config = vo.config_from_options(
         cache=cache,
         no_cache=no_cache,
@@ -216,17 +219,19 @@ def eval_command(
     with progress:
         state, metrics = asyncio.run(finish_run(runner))
     _print_main_table(metrics, oracle="oracle" in opts.backends)
-    out_console = Console(highlight=False)
-    out_console.print(f"run directory: {out}  (metrics.json, summary.md)")
+    out_console = make_console()
+    out_console.print(f"run directory: {esc(out)}  (metrics.json, summary.md)")
     if state.errors:
+        last = f" (last: {esc(line(state.last_error, 160))})" if state.last_error else ""
         err.print(
-            f"[yellow]{state.errors} work unit(s) failed[/]; see {out / 'errors.jsonl'} "
-            "(rerun with --resume to retry them)"
+            f"[yellow]{state.errors} of {state.units_total} work unit(s) failed[/]{last}; "
+            f"see {esc(out / 'errors.jsonl')} (rerun with --resume to retry them)",
+            soft_wrap=True,
         )
     if report:
         _build_report(out, err)
-    if metrics["counts"]["traces"] == 0:
-        raise typer.Exit(1)
+    if state.errors or metrics["counts"]["traces"] == 0:
+        raise typer.Exit(1)  # a run with failed units is not a success, whatever it printed
 
 
 _SHORT_HEADERS = {
