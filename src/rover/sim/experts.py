@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from rover.sim.env import SimEnv
 from rover.sim.experts_articulated import SCRIPTS as ARTICULATED_SCRIPTS
+from rover.sim.kitchen.experts import SCRIPTS as KITCHEN_SCRIPTS
 from rover.sim.motions import (
     CLOSE,
     GRASP_DZ,
@@ -226,6 +227,7 @@ SCRIPTS: dict[str, Callable[[SimEnv], list[Phase | Retry]]] = {
     "nut": _nut_script,
 }
 SCRIPTS.update(ARTICULATED_SCRIPTS)  # drawer, button, knob (rover's own fixtures)
+SCRIPTS.update(KITCHEN_SCRIPTS)  # kitchen dials and hinged parts, either direction
 
 
 def run_expert(sim: SimEnv, seed: int) -> Demo:

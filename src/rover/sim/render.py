@@ -75,6 +75,10 @@ class StateRenderer:
     def camera(self, view: str, lookat: np.ndarray | None = None) -> mujoco.MjvCamera | int:
         if view == "wrist":
             view = WRIST_CAMERA
+        # a model may carry its own camera for a view (the kitchen's, jittered per scene)
+        own = int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, f"rover_{view}"))
+        if own >= 0:
+            return own
         if view in FREE_VIEWS:
             fv = FREE_VIEWS[view]
             cam = mujoco.MjvCamera()

@@ -14,12 +14,29 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, Field
 
 from rover.sim.levels import LevelSpec
 
 TaskGroup = Literal[
-    "pick", "pick_and_place", "stacking", "doors", "composite", "drawers", "buttons", "knobs"
+    "pick",
+    "pick_and_place",
+    "stacking",
+    "doors",
+    "composite",
+    "drawers",
+    "buttons",
+    "knobs",
+    # the kitchen suite's groups (paper App. B, Table 4)
+    "doors_drawers",
+    "appliances",
+    "fixtures_knobs",
+    "microwave_thawing",
+    "restock_pantry",
+    "arrange_vegetables",
+    "prepare_coffee",
+    "presoak_pan",
 ]
 
 
@@ -94,6 +111,18 @@ class TaskSpec(BaseModel):
     max_expert_steps: int = 400
     bins: dict[str, int] = Field(default_factory=dict)  # PickPlace: object -> bin index
     clear_objects: list[str] = Field(default_factory=list)  # robosuite objects moved away
+    suite: str = "tabletop"  # "tabletop" (robosuite's tasks) or "kitchen" (rover.sim.kitchen)
+    # further wordings of `description`; one is picked per episode seed (`instruction`)
+    paraphrases: list[str] = Field(default_factory=list)
+
+    def instruction(self, seed: int) -> tuple[int, str]:
+        """(index, text) of the wording an episode with this seed is given; 0 = description.
+
+        Subtask names, levels and QA stay fixed: only the instruction shown varies.
+        """
+        wordings = [self.description, *self.paraphrases]
+        k = int(np.random.default_rng([int(seed), 7]).integers(len(wordings)))
+        return k, wordings[k]
 
     def object_spec(self, name: str) -> ObjectSpec:
         for obj in self.objects:

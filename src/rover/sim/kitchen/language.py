@@ -1,0 +1,60 @@
+"""Paraphrases of the kitchen tasks' instructions (issue 10, item 5).
+
+An episode is given one wording, picked by its seed (`TaskSpec.instruction`) and
+recorded; the subtask names the value function and the levels use never change.
+"""
+
+from __future__ import annotations
+
+PARAPHRASES: dict[str, list[str]] = {
+    "OpenDrawer": [
+        "Pull the drawer open by its handle.",
+        "Grab the handle of the drawer and slide the drawer out.",
+        "Open the kitchen drawer.",
+    ],
+    "CloseDrawer": [
+        "Push the open drawer shut.",
+        "Take the drawer's handle and slide the drawer closed.",
+        "Close the kitchen drawer.",
+    ],
+    "OpenSingleDoor": [
+        "Open the cabinet door by pulling its handle.",
+        "Swing the cabinet door open.",
+        "Grab the cabinet's handle and open its door.",
+    ],
+    "TurnOnMicrowave": [
+        "Turn the microwave on with its start button.",
+        "Push the microwave's start button.",
+        "Start the microwave.",
+    ],
+    "CoffeePressButton": [
+        "Push the button on top of the coffee machine.",
+        "Turn the coffee machine on.",
+        "Start the coffee machine with its button.",
+    ],
+    "TurnOnStove": [
+        "Turn the left stove knob to switch the burner on.",
+        "Switch on the front-left burner of the stove.",
+        "Twist the stove's left knob a quarter turn to turn the burner on.",
+    ],
+    "TurnOffStove": [
+        "Turn the left stove knob back to switch the burner off.",
+        "Switch off the front-left burner of the stove.",
+        "Twist the stove's left knob back to off.",
+    ],
+    "TurnOnSinkFaucet": [
+        "Turn the sink's handle to start the water.",
+        "Switch the faucet on with its lever.",
+        "Turn on the sink faucet.",
+    ],
+    "TurnOffSinkFaucet": [
+        "Turn the sink's handle back to stop the water.",
+        "Switch the faucet off with its lever.",
+        "Turn off the sink faucet.",
+    ],
+    "TurnSinkSpout": [
+        "Swivel the faucet spout to the left.",
+        "Swing the sink's spout over to the left side.",
+        "Rotate the sink spout to the left.",
+    ],
+}

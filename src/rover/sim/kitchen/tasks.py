@@ -1,0 +1,289 @@
+"""The kitchen suite's task specs (paper App. B, Tables 4 and 5; App. C.3; App. N).
+
+Each task names one kitchen fixture part (`rover.sim.kitchen.fixtures`); the env is
+``RoverKitchen`` with that part in reach and the rest of the kitchen drawn per seed. The
+object-centric subtasks are the tabletop fixtures' (grasp or touch the part, then move it
+to its target), levels follow Table 5's row for the task's group and the QA templates
+App. C.3's. Registry names carry the suite ("kitchen.OpenDrawer"): the tabletop suite
+already has an OpenDrawer and a CloseDrawer, and episode ids, demo files and caches are
+keyed by the task name.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rover.sim.kitchen.language import PARAPHRASES
+from rover.sim.tasks._common import FINGERS, named_levels
+from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
+
+SUITE = "kitchen"
+DRAWER_OPEN_Q = 0.12  # mirrors rover.sim.fixtures.drawer.OPEN_Q (no robosuite import here)
+DRAWER_START_OPEN = 0.14  # ... and START_OPEN
+PRESS_Q = -0.010  # ... rover.sim.fixtures.button.PRESS_Q
+QUARTER = float(np.pi / 2)
+DOOR_OPEN = 1.2  # rad a cabinet door swings to count as open
+SPOUT_TURN = 0.8  # rad the sink spout swivels
+
+
+def _part(name: str, fixture: str, body: str, centre: str, **sites: str) -> ObjectSpec:
+    return ObjectSpec(
+        name=name,
+        body=f"{fixture}_{body}",
+        centre=f"{fixture}_{centre}",
+        sites={k: f"{fixture}_{v}" for k, v in sites.items()},
+        graspable=False,
+    )
+
+
+def _qa(obj: str, items: list[tuple[str, str, str]]) -> list[QATemplate]:
+    return [QATemplate(id=i, text=t, event=e, object=obj) for i, t, e in items]
+
+
+def _spec(name: str, **fields) -> TaskSpec:
+    return TaskSpec(
+        name=f"{SUITE}.{name}",
+        env_name="RoverKitchen",
+        suite=SUITE,
+        paraphrases=PARAPHRASES.get(name, []),
+        **fields,
+    )
+
+
+def _move(name: str, obj: str, point: str, goal: str, signal: str) -> SubtaskSpec:
+    return SubtaskSpec(
+        name=name,
+        object=obj,
+        robot_points=FINGERS,
+        object_points=[point, point],
+        goal=goal,
+        beta=0.8,
+        end_signal=signal,
+    )
+
+
+def _reach(name: str, obj: str, point: str, signal: str) -> SubtaskSpec:
+    return SubtaskSpec(
+        name=name, object=obj, robot_points=FINGERS, object_points=[point, point], end_signal=signal
+    )
+
+
+# --------------------------------------------------------------- doors/drawers
+def _drawer(closing: bool) -> TaskSpec:
+    verb, ing = ("close", "closing") if closing else ("open", "opening")
+    push, end = ("push", "closed") if closing else ("pull", "open")
+    kwargs = {"fixture": "Drawer", "part": "drawer"}
+    if closing:  # closed = at most 10% open: 93% of the way from 14 cm
+        kwargs.update(start_q=DRAWER_START_OPEN, target=0.0, reach=0.93)
+    else:
+        kwargs.update(target=DRAWER_OPEN_Q)
+    return _spec(
+        "CloseDrawer" if closing else "OpenDrawer",
+        env_kwargs=kwargs,
+        description=f"Grasp the drawer handle and {push} the drawer {end}.",
+        group="doors_drawers",
+        objects=[_part("drawer", "Drawer", "drawer", "centre", handle="handle")],
+        goals={f"drawer_{verb}": GoalSpec(kind="fixture", object="drawer", body="handle")},
+        subtasks=[
+            _reach("grasp the drawer handle", "drawer", "drawer:handle", "grasped:drawer"),
+            _move(
+                f"{push} the drawer {end}",
+                "drawer",
+                "drawer:handle",
+                f"goal:drawer_{verb}",
+                f"drawer_{'closed' if closing else 'opened'}:drawer",
+            ),
+        ],
+        levels=named_levels(
+            [["Approach the drawer"], [f"Start {ing} the drawer"]],
+            [
+                "Fail to approach the drawer",
+                "Approach the drawer",
+                "Contact the drawer",
+                f"Start {ing} the drawer",
+                f"Finish {ing} the drawer",
+            ],
+        ),
+        qa_templates=_qa(
+            "drawer",
+            [
+                ("did_contact", "Did the robot contact the drawer handle? If so, when?", "contact"),
+                ("did_grasp", "Did the robot grasp the drawer handle? If so, when?", "grasp"),
+                (
+                    f"did_{verb}_start",
+                    f"Did the robot start {ing} the drawer? If so, when?",
+                    f"{verb}_start",
+                ),
+                (
+                    f"did_{verb}_finish",
+                    f"Did the robot completely {verb} the drawer? If so, when?",
+                    f"{verb}_finish",
+                ),
+            ],
+        ),
+        expert="drawer_close" if closing else "drawer_open",
+        max_expert_steps=300,
+    )
+
+
+OPEN_SINGLE_DOOR = _spec(
+    "OpenSingleDoor",
+    env_kwargs={"fixture": "Cabinet", "part": "door", "target": DOOR_OPEN},
+    description="Grasp the cabinet door's handle and swing the door open.",
+    group="doors_drawers",
+    objects=[_part("door", "Cabinet", "door", "centre", handle="handle")],
+    goals={"door_swung": GoalSpec(kind="fixture", object="door", body="handle")},
+    subtasks=[
+        _reach("grasp the door handle", "door", "door:handle", "grasped:door"),
+        _move("swing the door open", "door", "door:handle", "goal:door_swung", "turned:door"),
+    ],
+    levels=named_levels(
+        [["Approach the door"], ["Start opening the door"]],
+        [
+            "Fail to approach the door",
+            "Approach the door",
+            "Contact the door",
+            "Start opening the door",
+            "Finish opening the door",
+        ],
+    ),
+    qa_templates=_qa(
+        "door",
+        [
+            ("did_contact", "Did the robot contact the door handle? If so, when?", "contact"),
+            ("did_grasp", "Did the robot grasp the door handle? If so, when?", "grasp"),
+            ("did_open_start", "Did the robot start opening the door? If so, when?", "open_start"),
+            (
+                "did_open_finish",
+                "Did the robot completely open the door? If so, when?",
+                "open_finish",
+            ),
+        ],
+    ),
+    expert="kitchen_swing",
+    max_expert_steps=320,
+)
+
+
+# ----------------------------------------------------------- appliances on/off
+def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
+    return _spec(
+        name,
+        env_kwargs={"fixture": fixture, "part": "button", "target": PRESS_Q / 0.9},
+        description=f"Press the start button of the {appliance} to turn it on.",
+        group="appliances",
+        objects=[_part("button", fixture, "button", "top", top="top")],
+        goals={"button_pressed": GoalSpec(kind="fixture", object="button", body="top")},
+        subtasks=[
+            _reach(
+                f"reach the {appliance}'s start button", "button", "button:top", "touched:button"
+            ),
+            _move(
+                "press the button down",
+                "button",
+                "button:top",
+                "goal:button_pressed",
+                "pressed:button",
+            ),
+        ],
+        levels=named_levels(
+            [[], []],
+            [
+                "Fail to approach the on/off button",
+                "Approach the on/off button",
+                f"Press the button and turn the {appliance} on",
+            ],
+        ),
+        qa_templates=_qa(
+            "button",
+            [
+                (
+                    "did_press",
+                    f"Did the robot press the start button of the {appliance}? If so, when?",
+                    "press",
+                ),
+                ("did_turn_on", f"Did the robot turn the {appliance} on? If so, when?", "turn_on"),
+            ],
+        ),
+        expert="button",
+        max_expert_steps=200,
+    )
+
+
+# ---------------------------------------------------------- fixtures and knobs
+def _dial(
+    name: str,
+    fixture: str,
+    part_words: str,
+    thing: str,
+    on: bool,
+    tip: str = "tip",
+    kind: str = "knob",
+    turn: float = QUARTER,
+) -> TaskSpec:
+    """A part turned about a vertical axis: stove knob, faucet handle, sink spout."""
+    kwargs: dict = {"fixture": fixture, "part": kind, "target": turn if on else 0.0}
+    if not on:
+        kwargs["start_q"] = turn
+    if kind != "knob":
+        kwargs["facts_as"] = "knob"
+    body = "knob" if kind == "knob" else kind
+    centre = "centre" if kind == "knob" else tip
+    state = "on" if on else "off"
+    what = f"turn {state} the {thing}" if kind == "knob" else f"turn the {thing}"
+    return _spec(
+        name,
+        env_kwargs=kwargs,
+        description=f"Grasp the {part_words} and {what}.",
+        group="fixtures_knobs",
+        objects=[_part("knob", fixture, body, centre, tip=tip)],
+        goals={"knob_turned": GoalSpec(kind="fixture", object="knob", body=tip)},
+        subtasks=[
+            _reach(f"grasp the {part_words}", "knob", "knob", "grasped:knob"),
+            _move(f"turn the {part_words}", "knob", "knob:tip", "goal:knob_turned", "turned:knob"),
+        ],
+        levels=named_levels(
+            [[f"Approach the {part_words}"], [f"Start turning the {part_words}"]],
+            [
+                f"Fail to approach the {part_words}",
+                f"Approach the {part_words}",
+                f"Contact the {part_words}",
+                f"Start turning the {part_words}",
+                f"Finish turning the {part_words}",
+            ],
+        ),
+        qa_templates=_qa(
+            "knob",
+            [
+                ("did_contact", f"Did the robot contact the {part_words}? If so, when?", "contact"),
+                (
+                    "did_turn_start",
+                    f"Did the robot start turning the {part_words}? If so, when?",
+                    "turn_start",
+                ),
+                (
+                    "did_turn_finish",
+                    f"Did the robot completely {what}? If so, when?",
+                    "turn_finish",
+                ),
+            ],
+        ),
+        expert="kitchen_turn" if kind == "knob" else "kitchen_swing",
+        max_expert_steps=280,
+    )
+
+
+TASKS: list[TaskSpec] = [
+    _drawer(closing=False),
+    _drawer(closing=True),
+    OPEN_SINGLE_DOOR,
+    _button("TurnOnMicrowave", "Microwave", "microwave"),
+    _button("CoffeePressButton", "Coffee", "coffee machine"),
+    _dial("TurnOnStove", "Stove", "stove knob", "stove", on=True),
+    _dial("TurnOffStove", "Stove", "stove knob", "stove", on=False),
+    _dial("TurnOnSinkFaucet", "Sink", "sink handle", "sink", on=True, tip="handle_tip"),
+    _dial("TurnOffSinkFaucet", "Sink", "sink handle", "sink", on=False, tip="handle_tip"),
+    _dial(
+        "TurnSinkSpout", "Sink", "sink spout", "sink spout", on=True, kind="spout", turn=SPOUT_TURN
+    ),
+]
