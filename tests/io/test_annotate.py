@@ -127,7 +127,7 @@ def test_dry_run_counts_calls_and_spends_nothing(lerobot3, tmp_path):
         assert server.count == 0
     assert not (tmp_path / "dry").exists()
     assert "3 episode(s) to annotate" in res.output
-    # without decompositions ROVER asks once per frame after the first of each episode
+    # the stand-in never decomposes: ROVER asks once per frame of every episode
     assert f"calls: {sum(LENGTHS)}" in res.output
     assert "estimated tokens:" in res.output and "image rule openai-high" in res.output
 
