@@ -1,4 +1,8 @@
-"""Fixtures for method tests: a scripted VLM that records every prompt it is shown."""
+"""Fixtures for method tests: a scripted VLM that records every prompt it is shown.
+
+Like a real model it stops at `max_tokens` (a word counts as a token): a longer answer
+is cut and reported with finish reason "length".
+"""
 
 from __future__ import annotations
 
@@ -6,6 +10,7 @@ from collections.abc import Callable
 
 import pytest
 
+from rover.vlm.testing import cut_words
 from rover.vlm.types import Completion, Prompt, SamplingParams, Usage
 
 
@@ -18,6 +23,7 @@ class ScriptedVLM:
     def __init__(self, script: Callable[[Prompt], str]) -> None:
         self.script = script
         self.prompts: list[Prompt] = []
+        self.params: list[SamplingParams] = []
         self.bound_to: list[str] = []
 
     def bind(self, episode) -> ScriptedVLM:
@@ -25,10 +31,21 @@ class ScriptedVLM:
         return self
 
     async def complete(self, prompt: Prompt, params: SamplingParams | None = None) -> Completion:
+        params = params or SamplingParams()
         self.prompts.append(prompt)
-        text = self.script(prompt)
-        usage = Usage(prompt_tokens=10 * len(prompt.images()) + 5, completion_tokens=3)
-        return Completion(text=text, usage=usage, backend=self.backend, model=self.model)
+        self.params.append(params)
+        text, cut = cut_words(self.script(prompt), params.max_tokens)
+        usage = Usage(
+            prompt_tokens=10 * len(prompt.images()) + 5, completion_tokens=len(text.split())
+        )
+        return Completion(
+            text=text,
+            usage=usage,
+            backend=self.backend,
+            model=self.model,
+            finish_reason="length" if cut else "stop",
+            truncated=cut,
+        )
 
     def steps(self, kind: str = "rover.step") -> list[Prompt]:
         return [p for p in self.prompts if p.meta.kind == kind]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -93,3 +95,19 @@ def test_description_vocabulary():
     assert describe(FrameFacts(objects={"can": ObjectFacts(on="table")})).endswith(
         "The can is on the table."
     )
+
+
+async def test_oracle_plans_from_the_task_not_from_what_the_attempt_reached():
+    from rover.io.source import load_episode
+    from rover.vlm.oracle import task_plan
+
+    # an L1 attempt never gets past the first subtask; a model would still plan both
+    bundled = Path(__file__).parents[2] / "src/rover/data/bundled/episodes"
+    ep = load_episode(str(bundled / "PickPlaceCan-L1-000"), frames=8)
+    assert [s.name for s in ep.truth.subtasks] == ["pick up the can"]
+    assert task_plan(ep) == ["pick up the can", "place the can in bin 4"]
+    trace = await get_method("rover").run(ep, OracleBackend())
+    assert trace.tree.planned_subtasks == task_plan(ep)
+    assert [c.subtask for c in trace.tree.children] == ["pick up the can"]
+    # the first of two subtasks: full-task progress is half the subtask's
+    assert trace.progress()[-1] == pytest.approx(100 * ep.truth.progress[-1], abs=1)

@@ -5,8 +5,9 @@ everything it produces is labelled as oracle output (`Trace.oracle`). The answer
 depends on what the prompt asks (`PromptMeta.kind`), in exactly the format the method's
 prompt requests:
 
-- "rover.step" at the root line: decomposes into the ground-truth subtasks one at a time
-  ("The robot needs to: <name>", with the plan "New subtasks: [...]" on the first one);
+- "rover.step" at the root line: decomposes like a model that knows the task, from the
+  task's full subtask list (the simulator task spec's, not only the subtasks this attempt
+  reached): "New subtasks: [...]" then "The robot needs to: <first>";
   inside a subtask line: that subtask's progress, ground-truth progress rescaled to the
   subtask's span (0% at the frame the previous subtask ended, 100% at its own end).
   Without subtasks (or when decomposition is not allowed) it reports full-task progress.
@@ -20,6 +21,11 @@ from `BackendConfig`: `flip_prob` flips each claim of a description with that pr
 (perception errors), `jitter` adds gaussian noise (percentage points) to every progress
 value. Noise is a pure function of (seed, frame, question), so runs are reproducible and
 independent of call order.
+
+Like a real model it honours `max_tokens`: a longer answer is cut at that many tokens
+(counted as the usage estimate counts them) and reported with finish reason "length", so
+tests and the demo see truncation. A re-ask that names `meta.extra["missing"]` frames is
+answered for those frames only.
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ import numpy as np
 from rover.errors import BackendError, InputError
 from rover.vlm.base import BaseBackend, RawAnswer
 from rover.vlm.config import BackendConfig
+from rover.vlm.tokens import estimate_text_tokens
 from rover.vlm.types import Prompt, PromptMeta, SamplingParams
 
 if TYPE_CHECKING:
@@ -97,12 +104,13 @@ def describe(facts: FrameFacts | None, flip_prob: float = 0.0, rng=None) -> str:
     return " ".join(out)
 
 
-def subtask_progress(truth: GroundTruth, j: int, pos: int) -> float:
+def subtask_progress(truth: GroundTruth, j: int, pos: int, planned: int | None = None) -> float:
     """Subtask j's progress at `pos` (0..100): truth rescaled to the subtask's span.
 
     0% at the frame the previous subtask ended (where ROVER's child line starts), 100% at
     the subtask's own end. When the video ends inside the subtask with the task unfinished,
-    its end is not a completion: the subtask's nominal share of the rest is used instead.
+    its end is not a completion: the subtask's nominal share of the rest of the plan
+    (`planned` subtasks in all, default: those the attempt reached) is used instead.
     """
     prog, subs = truth.progress, truth.subtasks
     s = subs[j]
@@ -110,7 +118,7 @@ def subtask_progress(truth: GroundTruth, j: int, pos: int) -> float:
     hi = prog[min(s.end, len(prog) - 1)]
     last = len(prog) - 1
     if s.end >= last and prog[last] < 0.999:
-        hi = lo + (1.0 - lo) / max(len(subs) - j, 1)
+        hi = lo + (1.0 - lo) / max((planned or len(subs)) - j, 1)
     if hi - lo < 1e-9:
         return 100.0 if pos >= s.end else 0.0
     return 100.0 * (prog[pos] - lo) / (hi - lo)
@@ -118,6 +126,41 @@ def subtask_progress(truth: GroundTruth, j: int, pos: int) -> float:
 
 def _fmt(p: float) -> str:
     return str(int(round(p)))
+
+
+def task_plan(episode: Episode) -> list[str]:
+    """The task's full subtask list, as a model that knows the task would plan it.
+
+    Simulated episodes name their task spec (`extra["sim_task"]`); its subtasks are the
+    plan. Elsewhere (or when the spec's names do not cover the attempt's) the subtasks in
+    the ground truth are used.
+    """
+    reached = [s.name for s in (episode.truth.subtasks if episode.truth else [])]
+    name = episode.extra.get("sim_task") if isinstance(episode.extra, dict) else None
+    if name:
+        try:  # task specs are plain data; imported only for simulated episodes
+            from rover.sim.tasks import get_task
+
+            plan = [s.name for s in get_task(str(name)).subtasks]
+        except Exception:  # noqa: BLE001 - an unknown or unloadable spec: use the truth
+            plan = []
+        if plan and reached == plan[: len(reached)]:
+            return plan
+    return reached
+
+
+def truncate_tokens(text: str, max_tokens: int) -> tuple[str, bool]:
+    """`text` cut to at most `max_tokens` tokens (as estimated), and whether it was cut."""
+    if estimate_text_tokens(text) <= max_tokens:
+        return text, False
+    lo, hi = 0, len(text)  # longest prefix within the budget: binary search on characters
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if estimate_text_tokens(text[:mid]) <= max_tokens:
+            lo = mid
+        else:
+            hi = mid - 1
+    return text[:lo], True
 
 
 def require_simulator_truth(episode: Episode) -> None:
@@ -166,13 +209,15 @@ class BoundOracle(OracleBackend):
         super().__init__(config)
         require_simulator_truth(episode)
         self.episode = episode
+        self.plan = task_plan(episode)
         self._descriptions: dict[int, str] = {}  # deterministic per frame: compute once
 
     def bind(self, episode: Episode) -> BoundOracle:
         return self if episode is self.episode else BoundOracle(episode, self.config)
 
     async def _generate(self, prompt: Prompt, params: SamplingParams) -> RawAnswer:
-        return RawAnswer(text=self.answer(prompt.meta))
+        text, cut = truncate_tokens(self.answer(prompt.meta), params.max_tokens)
+        return RawAnswer(text=text, finish_reason="length" if cut else "stop", truncated=cut)
 
     # -- answers ---------------------------------------------------------------------------
 
@@ -235,10 +280,11 @@ class BoundOracle(OracleBackend):
     def _frames(self, truth: GroundTruth, meta: PromptMeta) -> str:
         positions = self._positions(meta)
         labels = meta.extra.get("labels") or list(range(len(positions)))
+        wanted = set(meta.extra.get("missing") or labels)  # a re-ask after a cut-off reply
         blocks = [
             self._frame_block(truth, pos, meta.kind, label)
             for pos, label in zip(positions, labels, strict=False)
-            if label is not None
+            if label is not None and label in wanted
         ]
         return "\n\n".join(blocks)
 
@@ -251,15 +297,15 @@ class BoundOracle(OracleBackend):
     def _rover_step(self, truth: GroundTruth, meta: PromptMeta) -> str:
         pos = self._positions(meta)[-1]
         desc = self._desc(truth, pos)
-        subs = truth.subtasks
+        plan = self.plan
         allow = bool(meta.extra.get("allow_decompose", True))
         if not meta.subtask_path:
             done = len(meta.extra.get("completed", []))
-            if allow and subs and done < len(subs):
-                text = f"Frame description: {desc}\nThe robot needs to: {subs[done].name}"
-                if done == 0 and len(subs) > 1:
-                    text += "\nNew subtasks: [" + ", ".join(f"'{s.name}'" for s in subs) + "]"
-                return text
+            if allow and plan and done < len(plan):
+                text = f"Frame description: {desc}\n"
+                if done == 0 and len(plan) > 1:
+                    text += "New subtasks: [" + ", ".join(f"'{s}'" for s in plan) + "]\n"
+                return text + f"The robot needs to: {plan[done]}"
             p = self._full(truth, pos, "rover")
         else:
             j = self._subtask_index(
@@ -268,11 +314,12 @@ class BoundOracle(OracleBackend):
             if j is None:
                 p = self._full(truth, pos, "rover")
             else:
-                p = self._noisy(subtask_progress(truth, j, pos), "rover", pos, j)
+                planned = len(self.plan) if self.plan else None
+                p = self._noisy(subtask_progress(truth, j, pos, planned), "rover", pos, j)
         return f"Frame description: {desc}\nSubtask completion percentage: {_fmt(p)}%\n[next-frame]"
 
     def _rover_parent(self, truth: GroundTruth, meta: PromptMeta) -> str:
         done = len(meta.extra.get("completed", []))
-        if not meta.subtask_path and done < len(truth.subtasks):
-            return f"The robot needs to: {truth.subtasks[done].name}"
+        if not meta.subtask_path and done < len(self.plan):
+            return f"The robot needs to: {self.plan[done]}"
         return "Task complete"

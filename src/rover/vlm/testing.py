@@ -10,6 +10,11 @@ minus credentials), and answers from a script of `Reply`s, then from an `answer`
         server.script(Reply(status=429, headers={"retry-after": "0"}))  # first call: 429
         vlm = load_vlm(f"openai:test-model@{server.base_url}", config)
 
+Like a real provider, both honour the request's output limit (`max_tokens` /
+`max_completion_tokens`, Gemini `maxOutputTokens`): an answer longer than that many words
+(the servers count a word as a token) is cut and reported with finish reason "length" /
+"MAX_TOKENS", so the truncation handling of the methods runs against real HTTP.
+
 Test helpers only: nothing in rover imports this module.
 """
 
@@ -150,6 +155,16 @@ class _LoopbackServer:
         raise NotImplementedError
 
 
+def cut_words(text: str, limit: Any) -> tuple[str, bool]:
+    """`text` cut after `limit` whitespace-separated words (formatting kept), and if it was."""
+    if not isinstance(limit, int) or isinstance(limit, bool) or limit <= 0:
+        return text, False
+    for i, m in enumerate(re.finditer(r"\S+", text), start=1):
+        if i == limit:
+            return text[: m.end()], text[m.end() :].strip() != ""
+    return text, False
+
+
 def _count_images(obj: Any) -> int:
     """Image parts in a request body (OpenAI `image_url` or Gemini inline data)."""
     if isinstance(obj, dict):
@@ -176,6 +191,8 @@ class OpenAICompatServer(_LoopbackServer):
         if not path.rstrip("/").endswith("/chat/completions"):
             return 404, {"error": {"message": f"no route {path}", "type": "not_found"}}
         text = reply.text if reply.text is not None else self.answer(body)
+        limit = body.get("max_completion_tokens") or body.get("max_tokens")
+        text, cut = cut_words(text, limit)
         out: dict[str, Any] = {
             "id": f"chatcmpl-{self.count}",
             "object": "chat.completion",
@@ -185,7 +202,7 @@ class OpenAICompatServer(_LoopbackServer):
                 {
                     "index": 0,
                     "message": {"role": "assistant", "content": text},
-                    "finish_reason": "stop",
+                    "finish_reason": "length" if cut else "stop",
                 }
             ],
         }
@@ -225,9 +242,13 @@ class GeminiRESTServer(_LoopbackServer):
                 "error": {"code": 404, "message": f"no route {path}", "status": "NOT_FOUND"}
             }
         text = reply.text if reply.text is not None else self.answer(body)
+        config = body.get("generationConfig") or body.get("generation_config") or {}
+        limit = config.get("maxOutputTokens") or config.get("max_output_tokens")
+        text, cut = cut_words(text, limit)
+        finish = "MAX_TOKENS" if cut else "STOP"
         out: dict[str, Any] = {
             "candidates": [
-                {"content": {"role": "model", "parts": [{"text": text}]}, "finishReason": "STOP"}
+                {"content": {"role": "model", "parts": [{"text": text}]}, "finishReason": finish}
             ],
             "modelVersion": match.group("model"),
         }
