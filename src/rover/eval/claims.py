@@ -72,6 +72,7 @@ _MENTION = re.compile(
     rf"\b(?P<grip>gripper'?s?|fingers?|jaws|claw|end[\s-]effector|hand)\b"
     rf"|\b(?P<robot>robot(?:'s)?|arm|panda|manipulator)\b"
     rf"|\b(?P<pron>it|which|its)\b"
+    rf"|\b(?P<one>(?:red|green|blue|yellow|round|square|other|left|right)\s+one)\b"
     rf"|\b(?P<obj>(?:(?:{_MODS})\s+){{0,2}}(?:{_HEADS})(?:\s+\d+)?)\b",
     re.I,
 )
@@ -94,6 +95,7 @@ _ADJ_GRIPPER = re.compile(r"\b(?P<s>open|opened|closed)\s+gripper\b", re.I)
 
 _HOLD = re.compile(
     r"\b(?:hold|holds|holding|grasp|grasps|grasped|grasping|grip|grips|gripped|gripping|"
+    r"grab|grabs|grabbed|grabbing|secured|secures|securing|clasp|clasps|clasped|clasping|"
     r"clutch\w*|carry|carries|carried|carrying|transport\w*|"
     r"has\s+(?:a\s+)?(?:firm\s+|secure\s+|tight\s+|good\s+)?(?:grip|grasp|hold)\s+(?:on|of)|"
     r"(?:wrapped|clamped)\s+around|moving|moves|moved|"
@@ -105,7 +107,7 @@ _LIFT_VERB = re.compile(r"\b(?:lift|rais|pick)", re.I)
 _HOLD_PASSIVE = re.compile(
     r"^\s*(?:(?:is|are|remains|stays|still|now|being|appears|seems|to|be|has|been|securely|"
     r"firmly|tightly|safely|not|no\s+longer|isn't|yet)\s+)*"
-    r"(?:held|grasped|gripped|clamped|clutched|carried)\b"
+    r"(?:held|grasped|gripped|clamped|clutched|carried|grabbed|secured|clasped)\b"
     r"|^\s*(?:(?:is|are|remains|stays|still|now|securely|firmly|safely|not|no\s+longer|"
     r"isn't|yet)\s+)*"
     r"(?:in|between|within)\s+(?:the\s+|its\s+)?(?:robot's\s+)?(?:gripper|hand|grip|claw|"
@@ -122,7 +124,9 @@ _EMPTY = re.compile(
     r"(?:now\s+|still\s+)?(?P<e1>empty)\b|\b(?P<e2>empty)\s+(?:gripper|hand)\b"
     r"|\b(?:holding|holds|carrying|grasping|gripping|has)\s+(?P<e3>nothing)\b"
     r"|\b(?P<e4>nothing)\s+(?:is\s+)?(?:in|between)\s+(?:the|its)\s+(?:gripper|hand|grip|fingers)"
-    r"|\b(?:holding|holds|carrying|grasping|gripping)\s+(?P<any>anything)\b",
+    r"|\b(?:holding|holds|carrying|grasping|gripping)\s+(?P<any>anything)\b"
+    r"|\b(?P<e5>no)\s+(?:object|item|thing)\s+is\s+(?:currently\s+|now\s+)?(?:being\s+)?"
+    r"(?:held|grasped|gripped|in\s+the\s+gripper)",
     re.I,
 )
 _CONTACT = re.compile(
@@ -132,6 +136,14 @@ _CONTACT = re.compile(
     r"pushing\s+(?:down\s+)?on|interacted\s+with|interacting\s+with|"
     r"(?:closed|closes|closing|tightened)\s+(?:around|on))\b",
     re.I,
+)
+_CONTACT_PASSIVE = re.compile(
+    r"^\s*(?:(?:is|are|has|have|been|being|not|yet|now|still|n't|never)\s+)*"
+    r"(?:touched|contacted)\b",
+    re.I,
+)
+_PUSH_DOWN = re.compile(
+    r"\b(?:pushing|pressing|pushes|presses)\s+(?:the\s+)?(?:\w+\s+)?button\s+(?:down|in)\b", re.I
 )
 _CONTACT_ANY = re.compile(
     r"\b(?:touching|contacting|in\s+contact\s+with)\s+(?P<w>anything|nothing)\b", re.I
@@ -149,13 +161,13 @@ _ON_TABLE = re.compile(
     re.I,
 )
 _AT_START = re.compile(
-    r"\b(?:original|initial|starting|start)\s+(?:location|position|place|spot)\b"
+    r"\b(?:original|initial|starting|start)\s+(?:location|position|place|spot|orientation)\b"
     r"|\bwhere\s+it\s+(?:started|began|was)\b",
     re.I,
 )
 _IN_PLACE = re.compile(
     r"\b(?P<how>inside|into|in|within|out\s+of|outside(?:\s+of)?|reached|reaches|reach|"
-    r"onto|on|over|around)\s+(?:the\s+|its\s+|a\s+)?(?=(?:\w+\s+){0,2}?(?:bin|peg|post|rod)\b)",
+    r"onto|on|over|around|encircles|encircling|surrounds|surrounding)\s+(?:the\s+|its\s+|a\s+)?(?=(?:\w+\s+){0,2}?(?:bin|peg|post|rod)\b)",
     re.I,
 )
 _ON_OBJ = re.compile(r"\b(?:stacked\s+)?(?:on\s+top\s+of|onto|on|atop|upon)\s+(?:the\s+)?", re.I)
@@ -237,6 +249,11 @@ class _Reader:
                 out.append(_Mention("grip", m.group(0), m.start(), m.end()))
             elif m.group("robot"):
                 out.append(_Mention("robot", m.group(0), m.start(), m.end()))
+            elif m.group("one"):  # "the green one": the head of the last object named
+                if self.last_obj:
+                    head = self.last_obj.split()[-1]
+                    text = f"{m.group('one').split()[0].lower()} {head}"
+                    out.append(_Mention("obj", text, m.start(), m.end()))
             elif m.group("pron"):
                 if m.group(0).lower() == "its":
                     nxt = clause[m.end() : m.end() + 12].lower()
@@ -250,8 +267,8 @@ class _Reader:
             else:
                 text = normalise_name(m.group("obj"))
                 head = text.split()[-1] if not text.split()[-1].isdigit() else text.split()[-2]
-                if head in ("handle",) and out and out[-1].text == "its":
-                    continue
+                if head == "handle" and re.search(r"'s\s+$", clause[: m.start()]):
+                    continue  # "the nut's handle": the nut, already mentioned
                 kind = "place" if head in _PLACES else "obj"
                 if head in ("object", "item"):
                     if not self.last_obj:
@@ -381,12 +398,14 @@ def _clause_claims(clause: str, ms: list[_Mention]) -> list[Claim]:
         ):
             continue  # "the can is lifted": a state, read below
         _add(out, Claim("holding", obj.text, not neg, text))
-        if _LIFT_VERB.match(verb) and obj.text.split()[-1] not in _PARTS:
+        if _LIFT_VERB.search(verb) and obj.text.split()[-1] not in _PARTS:
             _add(out, Claim("lifted", obj.text, not neg, text))
     for obj in objs:
         tail = clause[obj.end :]
         if _HOLD_PASSIVE.match(tail):
             _add(out, Claim("holding", obj.text, not neg, text))
+        if _CONTACT_PASSIVE.match(tail):
+            _add(out, Claim("contact", obj.text, not neg, text))
     for m in _RELEASE.finditer(clause):
         if _intended(clause, m.start()):
             continue
@@ -456,12 +475,18 @@ def _part_claims(out: list[Claim], clause: str, part: _Mention, neg: bool, ms) -
         if _BUTTON_UP.search(clause):
             _add(out, Claim("pressed", name, neg, clause))
             return
+        if _PUSH_DOWN.search(clause) and not _intended(clause, _PUSH_DOWN.search(clause).start()):
+            _add(out, Claim("pressed", name, not neg, clause))
+            return
         for m in _PRESSED.finditer(clause):
             if not _intended(clause, m.start()):
                 _add(out, Claim("pressed", name, not neg, clause))
                 return
         return
     if name.split()[-1] == "handle":
+        return
+    if _AT_START.search(clause):  # "the knob is still in its original orientation"
+        _add(out, Claim("articulation", name, "open" if neg else "closed", clause))
         return
     pct = _PCT.search(clause)
     words = [

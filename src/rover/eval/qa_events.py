@@ -18,9 +18,6 @@ from rover.eval.claims import extract_claims
 from rover.eval.rule_judge import CLOSED_MAX, FULLY_OPEN_MIN, OPEN_MIN, _target
 
 _DROP_WORDS = re.compile(r"\b(drop(?:s|ped|ping)?|fell|falls|falling|slip(?:s|ped|ping)?)\b", re.I)
-_LIFT_WORDS = re.compile(
-    r"\b(lift(?:s|ed|ing)?|pick(?:s|ed|ing)?\s+up|rais(?:e|es|ed|ing))\b", re.I
-)
 
 
 @dataclass
@@ -186,10 +183,8 @@ def _event_here(ev: str, obj: str, target: str | None, a: Asserted, was_held: bo
     if ev == "grasp":
         # held, or the gripper closed while touching it (how the simulator defines a grasp)
         return _has(a.held, obj) or (a.gripper == "closed" and _has(a.touched, obj))
-    if ev == "pick_up":
-        return _get(a.lifted, obj) is True or (
-            _has(a.held, obj) and bool(_LIFT_WORDS.search(a.text))
-        )
+    if ev == "pick_up":  # lifted, said outright or by a lifting verb ("picks up the can")
+        return _get(a.lifted, obj) is True
     if ev == "place":
         where = _get(a.inside, obj) or _get(a.on, obj)
         return where is not None and (target is None or names_match(str(where), target))

@@ -26,7 +26,7 @@ from pathlib import Path
 from rover.episode import FrameFacts
 from rover.eval.agreement import CORPUS_VERSION, banks
 from rover.eval.agreement.handwritten import FRAME_CASES as HAND_FRAMES
-from rover.eval.agreement.handwritten import FRESH_CASES
+from rover.eval.agreement.handwritten import FRESH_CASES, SET_A_CASES
 from rover.eval.rule_judge import frame_verdict
 
 STYLES = ("gpt-4o", "gemini-2.5", "qwen2.5-vl")
@@ -457,8 +457,9 @@ def hand_cases(episodes) -> list[dict]:
     """The hand-written cases with their frame's task, family and facts filled in."""
     by_id = {ep.id: ep for ep in episodes}
     out = []
-    fresh = [{**c, "style": "handwritten-fresh", "fresh": True} for c in FRESH_CASES]
-    for c in HAND_FRAMES + fresh:
+    fresh = [{**c, "style": "handwritten-fresh", "force": "heldout"} for c in FRESH_CASES]
+    set_a = [{**c, "force": "dev"} for c in SET_A_CASES]
+    for c in HAND_FRAMES + set_a + fresh:
         ep = by_id[c["episode"]]
         facts = ep.truth.facts[c["frame"]].model_dump(mode="json")
         out.append({**c, "task": ep.task, "family": ep.task_group, "facts": facts})
@@ -468,13 +469,15 @@ def hand_cases(episodes) -> list[dict]:
 def assign_splits(cases: list[dict], prefix: str, rng: random.Random) -> list[dict]:
     order = list(range(len(cases)))
     rng.shuffle(order)
-    fresh = {id(c) for c in cases if c.get("fresh")}
-    pool = [i for i in order if id(cases[i]) not in fresh]
-    half = set(pool[: len(cases) // 2])
+    forced = {i: c["force"] for i, c in enumerate(cases) if c.get("force")}
+    pool = [i for i in order if i not in forced]
+    n_dev = len(cases) // 2 - sum(v == "dev" for v in forced.values())
+    half = set(pool[:n_dev])
     out = []
     for i, c in enumerate(cases):
-        c = {k: v for k, v in c.items() if k != "fresh"}
-        out.append({"id": f"{prefix}{i:04d}", "split": "dev" if i in half else "heldout", **c})
+        split = forced.get(i) or ("dev" if i in half else "heldout")
+        c = {k: v for k, v in c.items() if k != "force"}
+        out.append({"id": f"{prefix}{i:04d}", "split": split, **c})
     return out
 
 
@@ -487,8 +490,13 @@ def main(argv: list[str]) -> None:
     frames = build_frames(episodes, rng) + hand_cases(episodes)
     qa = build_qa(episodes, rng)
     here = Path(__file__).parent
-    for name, cases, prefix in (("frames.json", frames, "f"), ("qa.json", qa, "q")):
-        body = {"corpus_version": CORPUS_VERSION, "cases": assign_splits(cases, prefix, rng)}
+    for name, cases, prefix, seed in (
+        ("frames.json", frames, "f", 1601),
+        ("qa.json", qa, "q", 1602),
+    ):
+        # each file's split has its own seed: adding cases to one never reshuffles the other
+        split_rng = random.Random(seed)
+        body = {"corpus_version": CORPUS_VERSION, "cases": assign_splits(cases, prefix, split_rng)}
         (here / name).write_text(json.dumps(body, indent=1) + "\n")
         print(f"{name}: {len(cases)} cases")
 

@@ -370,10 +370,11 @@ FRAME_CASES = [
     ),
 ]
 
-# Written after the rule judge was tuned on the development half, and never used to tune
-# it: always held out, so their agreement is the judge's on phrasing it has not seen.
+# Set A: written after the rule judge was first tuned on the development half and first
+# measured as held out (50/60 = 83.3% agreement); then moved to the development half and
+# used to improve the rules. Set B below took its place as the fresh held-out set.
 FRESH = "PickPlaceCan-L7-000"
-FRESH_CASES = [
+SET_A_CASES = [
     _c(
         FRESH,
         20,
@@ -742,4 +743,127 @@ FRESH_CASES = [
         "The scene is well lit and the robot is ready to begin.",
         "inconclusive",
     ),
+]
+
+# Set B: the fresh held-out set, written before the rules were changed after set A and
+# never used to change them; its agreement is the one to quote for unseen phrasing.
+FRESH_CASES = [
+    _c("Lift-L3-000", 27, "The cube is elevated and secured between the gripper's two "
+       "fingers.", "true", true=["the cube is elevated"]),
+    _c("Lift-L3-000", 27, "The gripper has not yet picked up the block.", "false",
+       false=["has not yet picked up the block"]),
+    _c("Lift-L3-000", 27, "Holding the cube, the arm moves upward.", "true",
+       true=["holding the cube"]),
+    _c("Lift-L3-000", 29, "The block is back on the table and the gripper is still touching "
+       "it.", "true", true=["back on the table", "still touching it"]),
+    _c("Lift-L3-000", 29, "The cube is lifted high above the table.", "false",
+       false=["lifted high above the table"]),
+    _c("Lift-L3-000", 0, "An open gripper is positioned well above the red cube.", "true",
+       true=["an open gripper"]),
+    _c("Lift-L3-000", 0, "The cube is being carried by the robot.", "false",
+       false=["being carried by the robot"]),
+    _c("PickPlaceCan-L3-000", 22, "The fingers touch the can but have not secured it; the "
+       "can remains in the start bin.", "true", true=["the fingers touch the can",
+                                                       "remains in the start bin"]),
+    _c("PickPlaceCan-L3-000", 22, "The robot lifts the can out of the bin.", "false",
+       false=["lifts the can out of the bin"]),
+    _c("PickPlaceCan-L3-000", 22, "The can is securely in the robot's grip.", "false",
+       false=["securely in the robot's grip"]),
+    _c("PickPlaceCan-L3-000", 11, "The gripper is closed, but it is not touching anything.",
+       "true", true=["the gripper is closed", "not touching anything"]),
+    _c("PickPlaceCan-L3-000", 11, "The gripper's fingers are wide apart.", "false",
+       false=["fingers are wide apart"]),
+    _c("PickPlaceCan-L7-000", 5, "The robot has just picked up the soda can from the start "
+       "bin.", "true", true=["picked up the soda can"]),
+    _c("PickPlaceCan-L7-000", 5, "The soda can is still sitting in the first bin, untouched.",
+       "false", false=["still sitting in the first bin"]),
+    _c("PickPlaceCan-L7-000", 24, "The can has been lowered into bin 4 and the fingers are "
+       "still around it.", "true", true=["lowered into bin 4"]),
+    _c("PickPlaceCan-L7-000", 24, "The can is suspended in the air above the target bin.",
+       "false", false=["suspended in the air"]),
+    _c("PickPlaceMilk-L7-000", 25, "The milk carton is no longer held; it is not in any bin "
+       "yet.", "true", true=["no longer held"]),
+    _c("PickPlaceMilk-L7-000", 25, "The robot is transporting the carton high above the "
+       "bins.", "false", false=["transporting the carton"]),
+    _c("PickPlaceMilk-L7-000", 10, "The gripper makes contact with the milk carton.", "true",
+       true=["makes contact with the milk carton"]),
+    _c("PickPlaceMilk-L7-000", 10, "The milk is already in bin 1.", "false",
+       false=["already in bin 1"]),
+    _c("Restock-L5-000", 10, "The milk carton is in mid-air but not in the gripper — it "
+       "seems to be falling.", "true", true=["in mid-air", "not in the gripper"]),
+    _c("Restock-L5-000", 10, "The gripper holds the milk carton securely.", "false",
+       false=["holds the milk carton"]),
+    _c("Restock-L5-000", 50, "The can has been set in bin 4 while the milk already sits in "
+       "bin 1.", "true", true=["set in bin 4", "sits in bin 1"]),
+    _c("Restock-L5-000", 50, "The can is in bin 1 next to the milk.", "false",
+       false=["the can is in bin 1"]),
+    _c("Restock-L5-000", 28, "The gripper is touching the soda can, which has not been "
+       "lifted.", "true", true=["touching the soda can", "has not been lifted"]),
+    _c("NutAssemblyRound-L7-000", 20, "The nut is falling: the gripper is no longer holding "
+       "it.", "true", true=["no longer holding it"]),
+    _c("NutAssemblyRound-L7-000", 20, "The nut is firmly held by the gripper.", "false",
+       false=["firmly held by the gripper"]),
+    _c("NutAssemblyRound-L7-000", 22, "The robot has regrasped the round nut and raised it "
+       "again.", "true", true=["raised it"]),
+    _c("NutAssemblyRound-L7-000", 22, "The nut is already on the peg.", "false",
+       false=["already on the peg"]),
+    _c("NutAssemblyRound-L7-000", 0, "The nut lies flat on the table.", "true",
+       true=["lies flat on the table"]),
+    _c("Stack-L7-000", 8, "The gripper has closed on the red block, which is still on the "
+       "table.", "true", true=["which is still on the table"]),
+    _c("Stack-L7-000", 8, "The red block is already stacked on the green block.", "false",
+       false=["already stacked on the green block"]),
+    _c("Stack-L7-000", 27, "The red cube rests atop the green cube.", "true",
+       true=["rests atop the green cube"]),
+    _c("Stack-L7-000", 27, "The green block is sitting on the red block.", "false",
+       false=["the green block is sitting on the red block"]),
+    _c("Door-L5-000", 17, "The robot holds the handle and the door has begun to open "
+       "slightly.", "true", true=["holds the handle"]),
+    _c("Door-L5-000", 17, "The door is fully opened.", "false", false=["fully opened"]),
+    _c("Door-L5-000", 14, "The gripper is touching the door handle but the door is still "
+       "closed.", "true", true=["touching the door handle", "still closed"]),
+    _c("Door-L5-000", 14, "The door is swinging wide open.", "false",
+       false=["swinging wide open"]),
+    _c("OpenDrawer-L5-000", 15, "The drawer is about 60 percent open and the gripper is "
+       "open.", "true", true=["about 60 percent open", "the gripper is open"]),
+    _c("OpenDrawer-L5-000", 15, "The drawer is closed and the gripper is closed.", "false",
+       false=["the drawer is closed", "the gripper is closed"]),
+    _c("OpenDrawer-L5-000", 26, "The drawer has been fully extended.", "true",
+       true=["fully extended"]),
+    _c("CloseDrawer-L5-000", 22, "The robot is holding the drawer handle; the drawer is "
+       "partway closed.", "true", true=["holding the drawer handle", "partway closed"]),
+    _c("CloseDrawer-L5-000", 22, "The drawer is completely shut.", "false",
+       false=["completely shut"]),
+    _c("CloseDrawer-L5-000", 0, "The drawer sits fully open and the robot has not grabbed "
+       "it.", "true", true=["fully open", "has not grabbed it"]),
+    _c("PressButton-L3-000", 21, "The gripper is in contact with the button, which has not "
+       "been pressed in yet.", "true", true=["in contact with the button",
+                                             "has not been pressed in yet"]),
+    _c("PressButton-L3-000", 21, "The button is already pushed in.", "false",
+       false=["already pushed in"]),
+    _c("PressButton-L3-000", 29, "The robot has pushed the button, turning the appliance on.",
+       "true", true=["pushed the button"]),
+    _c("PressButton-L3-000", 29, "The button has not been pressed.", "false",
+       false=["has not been pressed"]),
+    _c("TurnKnob-L5-000", 16, "The gripper grasps the knob, which has been turned about 20%.",
+       "true", true=["grasps the knob", "turned about 20%"]),
+    _c("TurnKnob-L5-000", 16, "The knob has been fully rotated.", "false",
+       false=["fully rotated"]),
+    _c("TurnKnob-L5-000", 28, "The dial has been turned completely and the gripper has let "
+       "go.", "true", true=["turned completely", "let go"]),
+    _c("TurnKnob-L5-000", 28, "The robot is still gripping the dial.", "false",
+       false=["still gripping the dial"]),
+    _c("Door-L5-000", 2, "The robot begins its approach to the door.", "inconclusive"),
+    _c("Lift-L3-000", 3, "The arm seems to hesitate before moving closer to the cube.",
+       "inconclusive"),
+    _c("PickPlaceMilk-L7-000", 6, "The robot is planning how to pick up the milk.",
+       "inconclusive"),
+    _c("Stack-L7-000", 2, "Two cubes of different colours are visible on the table.",
+       "inconclusive"),
+    _c("TurnKnob-L5-000", 2, "The robot arm is going to turn the knob.", "inconclusive"),
+    _c("OpenDrawer-L5-000", 2, "The robot will try to open the drawer next.", "inconclusive"),
+    _c("PressButton-L3-000", 1, "The arm is lowering itself toward the button.",
+       "inconclusive"),
+    _c("PickPlaceCan-L7-000", 23, "**Analysis:** the gripper is closed and the can is "
+       "lifted out of bin 4 again.", "true", true=["the gripper is closed", "the can is lifted"]),
 ]
