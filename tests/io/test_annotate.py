@@ -17,6 +17,7 @@ from typer.testing import CliRunner
 from rover.annotate import AnnotateOptions, run_annotate
 from rover.cli import app
 from rover.errors import InputError
+from rover.io.source import open_source
 from rover.vlm.testing import OpenAICompatServer
 from rover.vlm.types import Completion, Usage
 
@@ -186,3 +187,23 @@ def test_annotate_other_sources_with_sample(tmp_path, make_rlds, make_robomimic)
     opts = AnnotateOptions(source=f"hdf5:{h5}", out=tmp_path / "b", task="lift", vlm=_ScriptVLM())
     result = asyncio.run(run_annotate(opts))
     _check_frames_table(result.frames_path, lengths=(5, 4))
+
+
+def test_annotate_rover_dataset_with_the_oracle(tmp_path):
+    from rover.sim import bundled_dataset_path
+
+    out = tmp_path / "oracle"
+    args = ["annotate", str(bundled_dataset_path()), "--backend", "oracle", "--out", str(out)]
+    res = CliRunner().invoke(app, [*args, "--sample", "2", "--frames", "8", "--method", "gvl"])
+    assert res.exit_code == 0, res.output
+    assert "ORACLE" in res.output
+    episodes = pq.read_table(out / "episodes.parquet").to_pylist()
+    assert len(episodes) == 2 and all(e["backend"] == "oracle" for e in episodes)
+    # the oracle follows simulator truth: final progress is the last sampled frame's truth
+    reader = open_source(bundled_dataset_path())
+    for e in episodes:
+        truth = reader.read(e["episode_id"], frames=8).truth.progress[-1]
+        assert e["final_progress"] == pytest.approx(100 * truth, abs=0.5)
+        assert e["success"] == (e["final_progress"] >= 95)
+    rows = pq.read_table(out / "frames.parquet").to_pylist()
+    assert len(rows) == 16 and all(r["description"] for r in rows[1:8])

@@ -165,6 +165,11 @@ def annotate_command(
         f"{result.calls:,} calls, {result.tokens:,} tokens",
         soft_wrap=True,
     )
+    if spec == "oracle":
+        console.print(
+            "[bold yellow]ORACLE[/] output: answers from simulator ground truth, not a VLM",
+            soft_wrap=True,
+        )
     console.print(f"frames:   {result.frames_path}", soft_wrap=True)
     console.print(f"episodes: {result.episodes_path}", soft_wrap=True)
     if result.in_place_path is not None:
