@@ -1,6 +1,6 @@
 """Tokens and VLM calls per video for every VLM method (paper App. G), with the oracle.
 
-    python benchmarks/token_cost.py [--frames 30 60 120 240] [--json PATH]
+    python benchmarks/token_cost.py [--frames 30 60 120 240] [--json PATH] [--parse-only]
 
 Each method runs on a synthetic two-subtask pick-and-place episode (256 px frames, known
 subtask structure) with the oracle backend, so ROVER decomposes exactly as a model
@@ -12,6 +12,9 @@ recording), excluding the time spent inside the backend.
 Targets checked (App. G): ROVER <= 1/3 of GVL's tokens at 30 frames, <= 1/5 at 60,
 <= 1/15 at 240; ROVER tokens(240) / tokens(30) <= 9 (linear scaling); calls per video
 <= 1.25 x frames; framework overhead <= 5 ms per call.
+
+A second table times reply parsing on 100 KB of adversarial and realistic text (issue 15:
+parsing must be linear in reply length): `parse_step` under 50 ms on every input.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import json
+import random
 import sys
 import time
 from pathlib import Path
@@ -27,6 +31,7 @@ import numpy as np
 
 from rover.episode import Episode, Event, FrameFacts, GroundTruth, ObjectFacts, StateType, Subtask
 from rover.methods import get_method
+from rover.methods.parse import parse_frames, parse_step
 from rover.methods.registry import NON_VLM_METHODS, method_names
 from rover.vlm.config import BackendConfig
 from rover.vlm.oracle import OracleBackend
@@ -119,6 +124,61 @@ def measure(method: str, n: int) -> dict:
     }
 
 
+PARSE_BYTES = 100_000
+
+
+def parse_inputs(size: int = PARSE_BYTES) -> dict[str, str]:
+    """Texts of `size` characters that used to make the parsers quadratic, and real ones."""
+    rng = random.Random(0)
+    block = (
+        "**Frame {k}:**\n- **Frame description:** The gripper is closed around the can; "
+        "the robot needs to lift it next.\n- **Task completion percentage:** {p}%\n\n"
+    )
+    gvl = "".join(block.format(k=k, p=k % 100) for k in range(1, 2000))
+    printable = "".join(rng.choice("abc xyz:%[]{}|#*-\n0123456789.") for _ in range(size))
+    texts = {
+        "newlines": "\n" * size,
+        "spaces": " " * size,
+        "short lines": "a\n" * (size // 2),
+        "one digit run": "1" * size,
+        "open braces": "{" * size,
+        "open brackets": "[ " * (size // 2),
+        "labels on one line": "Frame description: x. " * (size // 22),
+        "percentages": "Subtask completion percentage: 1% " * (size // 34),
+        "frame headers": "Frame 1: 1%\n" * (size // 12),
+        "plan items": "New subtasks: ['" + "a', '" * (size // 5),
+        "random symbols": printable,
+        "GVL reply, markdown": gvl,
+    }
+    return {name: (t * (size // max(len(t), 1) + 1))[:size] for name, t in texts.items()}
+
+
+def parse_rows(repeat: int = 5) -> list[dict]:
+    """Best-of-`repeat` CPU milliseconds for parse_step and parse_frames on each input.
+
+    CPU time (`time.process_time`), not wall time: on a shared machine the wall clock
+    also counts the time other processes held the core.
+    """
+    rows = []
+    for name, t in parse_inputs().items():
+        row = {"input": name, "chars": len(t)}
+        for fn in (parse_step, parse_frames):
+            best = float("inf")
+            for _ in range(repeat):
+                t0 = time.process_time()
+                fn(t)
+                best = min(best, time.process_time() - t0)
+            row[fn.__name__ + "_ms"] = round(1000 * best, 2)
+        rows.append(row)
+    return rows
+
+
+def print_parse_rows(rows: list[dict]) -> None:
+    print(f"\n{'reply (100 KB), CPU ms':<22}{'parse_step':>15}{'parse_frames':>17}")
+    for r in rows:
+        print(f"{r['input']:<22}{r['parse_step_ms']:>15.2f}{r['parse_frames_ms']:>17.2f}")
+
+
 def check_targets(rows: list[dict]) -> list[tuple[str, float, float, bool]]:
     tok = {(r["method"], r["frames"]): r["total_tokens"] for r in rows}
     out = []
@@ -143,7 +203,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--frames", type=int, nargs="+", default=[30, 60, 120, 240])
     ap.add_argument("--methods", nargs="+", default=None, help="default: every VLM method")
     ap.add_argument("--json", type=Path, default=None, help="also write the rows as JSON")
+    ap.add_argument("--parse-only", action="store_true", help="only the parsing table")
     args = ap.parse_args(argv)
+    if args.parse_only:
+        prows = parse_rows()
+        print_parse_rows(prows)
+        worst = max(r["parse_step_ms"] for r in prows)
+        verdict = "PASS" if worst <= 50 else "FAIL"
+        print(f"\n  {verdict}  parse_step worst on 100 KB: {worst:.1f} ms (limit 50)")
+        return 0
     methods = args.methods or [m for m in method_names() if m not in NON_VLM_METHODS]
     measure("rover", 8)  # warm-up: imports, tokenizer load
     rows = []
@@ -159,13 +227,18 @@ def main(argv: list[str] | None = None) -> int:
                 f"{r['wall_s']:>8.2f}",
                 flush=True,
             )
+    prows = parse_rows()
+    print_parse_rows(prows)
     targets = check_targets(rows)
+    worst = max(r["parse_step_ms"] for r in prows)
+    targets.append(("parse_step on 100 KB, worst input (ms)", worst, 50.0, worst <= 50.0))
     print("\ntargets")
     for name, value, limit, ok in targets:
         print(f"  {'PASS' if ok else 'FAIL'}  {name}: {value:.3f} (limit {limit:.3f})")
     if args.json:
         payload = {
             "rows": rows,
+            "parse": prows,
             "targets": [
                 {"name": n, "value": v, "limit": lim, "pass": ok} for n, v, lim, ok in targets
             ],

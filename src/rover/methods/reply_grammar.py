@@ -165,18 +165,33 @@ def leading_percentage(value: str) -> float | None:
 
 def drop_percentage_tail(text: str) -> str:
     """Free text without a closing percentage ("The gripper is open. 10%" -> first part)."""
+    if not _ends_with_percent(text):
+        return text
     m = _PCT_TAIL.search(text[-80:])
     return text[: len(text) - len(text[-80:]) + m.start()].strip() if m else text
 
 
+def _has_percent(text: str) -> bool:
+    return "%" in text or "percent" in text.lower()
+
+
+def _ends_with_percent(text: str) -> bool:
+    t = text.rstrip(" \t.!)")
+    return t.endswith("%") or t[-7:].lower() == "percent"
+
+
 def tail_percentage(text: str) -> float | None:
     """The percentage closing a piece of free text ("The drawer is 40% open. 12%" -> 12)."""
+    if not _ends_with_percent(text):
+        return None
     m = _PCT_TAIL.search(text[-80:])
     return any_percentage(m.group(0)) if m else None
 
 
 def any_percentage(text: str) -> float | None:
     """The first "N%" / "N percent" in free text."""
+    if not _has_percent(text):
+        return None
     m = _PCT_ANY.search(text)
     return _to_float(m.group(1)) if m else None
 
@@ -238,8 +253,14 @@ def _label_ok(line: str, m: re.Match[str], kind: str) -> bool:
     return colon or at_start and not rest  # a description label, or its heading
 
 
+_KEYWORDS = ("descr", "complet", "progress", "needs", "plan", "task")
+
+
 def labels(line: str) -> list[tuple[str, int, int]]:
     """(kind, label start, value start) of every field label on one line."""
+    low = line.lower()
+    if not any(k in low for k in _KEYWORDS):
+        return []  # the common case for prose lines: no label word at all
     out = []
     for m in _LABEL.finditer(line):
         kind = next(k for k in ("desc", "pct", "needs", "plan", "sub") if m.group(k))
