@@ -116,7 +116,9 @@ _HOLD_PASSIVE = re.compile(
 )
 _RELEASE = re.compile(
     r"\b(?:released|releases|releasing|release|let\s+go|lets\s+go|letting\s+go|dropped|drops|"
-    r"dropping|opened\s+(?:its\s+)?(?:gripper\s+)?to\s+release)\b(?:\s+of)?",
+    r"dropping|opened\s+(?:its\s+)?(?:gripper\s+)?to\s+release|"
+    r"(?:slips|slipped|slipping|falls|fell|falling)\s+(?:out\s+of|from)|has\s+fallen\s+from)"
+    r"\b(?:\s+of)?",
     re.I,
 )
 _EMPTY = re.compile(

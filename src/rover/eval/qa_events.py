@@ -29,6 +29,7 @@ class Asserted:
     held: set[str] = field(default_factory=set)
     released: bool = False  # "not holding anything" / "gripper is empty"
     not_held: set[str] = field(default_factory=set)
+    dropped: set[str] = field(default_factory=set)  # "drops the can", "the can slips out"
     touched: set[str] = field(default_factory=set)
     lifted: dict[str, bool] = field(default_factory=dict)
     inside: dict[str, str] = field(default_factory=dict)  # object -> place, as said
@@ -65,6 +66,8 @@ def asserted_states(descriptions: list[str | None], task: str | None = None) -> 
                 a.gripper = str(c.value)
             elif c.kind == "holding":
                 (a.held.add if c.value else a.not_held.add)(s)
+                if not c.value and _DROP_WORDS.search(c.text):
+                    a.dropped.add(s)
             elif c.kind == "holding_any":
                 a.released = a.released or not c.value
             elif c.kind == "contact" and c.value:
@@ -189,7 +192,7 @@ def _event_here(ev: str, obj: str, target: str | None, a: Asserted, was_held: bo
         where = _get(a.inside, obj) or _get(a.on, obj)
         return where is not None and (target is None or names_match(str(where), target))
     if ev == "drop":
-        if _DROP_WORDS.search(a.text) and obj.split()[-1].lower() in a.text.lower():
+        if _has(a.dropped, obj):
             return True
         released = a.released or _has(a.not_held, obj)
         where = _get(a.inside, obj) or _get(a.on, obj)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from rover.episode import FrameFacts
-from rover.eval.claim_names import names_match, normalise_name, resolve
+from rover.eval.claim_names import head_and_modifiers, names_match, normalise_name, resolve
 from rover.eval.claims import Claim, extract_claims
 
 PCT_TOLERANCE = 0.15
@@ -83,13 +83,24 @@ def known_names(facts: FrameFacts) -> list[str]:
 
 
 def goal_of(task: str | None, obj: str) -> str | None:
-    """The bin the task wants `obj` in: "... put the milk in bin 1 and the can in bin 4"."""
+    """The bin the task wants `obj` in: "... put the milk in bin 1 and the can in bin 4".
+
+    The object is looked for by its name, then by its head noun ("cylindrical can" ->
+    "can", "milk carton" -> "milk"); a task naming one bin gives that bin for anything.
+    """
     if not task:
         return None
-    obj_words = r"\s+".join(re.escape(w) for w in normalise_name(obj).split())
-    near = rf"\b{obj_words}\s+(?:\w+\s+){{0,3}}?(?:in|into)\s+(bin\s*\d+)"
-    m = re.search(near, task, re.I) or re.search(r"\b(?:in|into)\s+(bin\s*\d+)", task, re.I)
-    return m.group(1).lower() if m else None
+    head, _ = head_and_modifiers(obj)
+    for name in dict.fromkeys([normalise_name(obj), head]):
+        if not name:
+            continue
+        words = r"\s+".join(re.escape(w) for w in name.split())
+        near = rf"\b{words}\s+(?:\w+\s+){{0,3}}?(?:in|into)\s+(bin\s*\d+)"
+        m = re.search(near, task, re.I)
+        if m:
+            return m.group(1).lower()
+    bins = set(re.findall(r"\b(?:in|into)\s+(bin\s*\d+)", task, re.I))
+    return bins.pop().lower() if len(bins) == 1 else None
 
 
 _GOAL_WORDS = re.compile(r"\b(?:target|goal|correct|destination|other|second)\b")

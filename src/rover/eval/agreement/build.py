@@ -26,7 +26,7 @@ from pathlib import Path
 from rover.episode import FrameFacts
 from rover.eval.agreement import CORPUS_VERSION, banks
 from rover.eval.agreement.handwritten import FRAME_CASES as HAND_FRAMES
-from rover.eval.agreement.handwritten import FRESH_CASES, SET_A_CASES
+from rover.eval.agreement.handwritten import FRESH_CASES, QA_SEQUENCES, SET_A_CASES
 from rover.eval.rule_judge import frame_verdict
 
 STYLES = ("gpt-4o", "gemini-2.5", "qwen2.5-vl")
@@ -466,6 +466,41 @@ def hand_cases(episodes) -> list[dict]:
     return out
 
 
+def hand_qa_cases(episodes) -> list[dict]:
+    """The hand-written QA sequences as cases, one per question; always held out."""
+    by_id = {ep.id: ep for ep in episodes}
+    out = []
+    for seq in QA_SEQUENCES:
+        ep = by_id[seq["episode"]]
+        n, k = ep.num_frames, len(seq["descriptions"])
+        positions = [round(i * (n - 1) / max(k - 1, 1)) for i in range(k)]
+        answers = dict(seq["answers"])
+        for item in ep.truth.qa:
+            key = (
+                f"{item.event}:{item.object}"
+                if f"{item.event}:{item.object}" in answers
+                else item.event
+            )
+            at = answers.pop(key)
+            label = item.model_copy(update={"answer": at is not None, "frame": at})
+            out.append(
+                {
+                    "style": "handwritten-fresh",
+                    "force": "heldout",
+                    "episode": ep.id,
+                    "task": ep.task,
+                    "family": ep.task_group,
+                    "positions": positions,
+                    "descriptions": list(seq["descriptions"]),
+                    "item": label.model_dump(mode="json"),
+                    "qa": [q.model_dump(mode="json") for q in ep.truth.qa],
+                }
+            )
+        if answers:
+            raise ValueError(f"{ep.id}: answers for questions it does not ask: {answers}")
+    return out
+
+
 def assign_splits(cases: list[dict], prefix: str, rng: random.Random) -> list[dict]:
     order = list(range(len(cases)))
     rng.shuffle(order)
@@ -488,7 +523,7 @@ def main(argv: list[str]) -> None:
     rng = random.Random(16)
     episodes = list(_episodes(dirs))
     frames = build_frames(episodes, rng) + hand_cases(episodes)
-    qa = build_qa(episodes, rng)
+    qa = build_qa(episodes, rng) + hand_qa_cases(episodes)
     here = Path(__file__).parent
     for name, cases, prefix, seed in (
         ("frames.json", frames, "f", 1601),
