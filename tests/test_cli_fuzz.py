@@ -330,8 +330,8 @@ def _eval_cases() -> list[Case]:
         Case("eval: dataset.json bytes", [*E, *out, "--dataset", "{t}/ds_nonutf8"], "dataset"),
         Case("eval: episode.json bytes", [*E, *out, "--dataset", "{t}/ds_badep"], "episode"),
         # an episode that cannot be read fails its units (the others run): non-zero, counted
-        Case("eval: view ..", [*E, *out, "--dataset", "{t}/ds_dotdot"], "not a plain name"),
-        Case("eval: view absolute", [*E, *out, "--dataset", "{t}/ds_abs"], "not a plain name"),
+        Case("eval: view ..", [*E, *out, "--dataset", "{t}/ds_dotdot"], "view name"),
+        Case("eval: view absolute", [*E, *out, "--dataset", "{t}/ds_abs"], "view name"),
         Case("eval: no data", [*E, *out], "--dataset"),
         Case("eval: both data", [*E, *out, *ds, "--source", "{t}/clip.mp4"], "not both"),
         Case("eval: --source missing", [*E, *out, "--source", "{t}/nope.mp4"], "nope"),
@@ -387,7 +387,7 @@ def _report_cases() -> list[Case]:
         Case("report: run is a file", ["report", "{t}/a_file"], "a_file"),
         Case("report: empty run dir", ["report", "{t}/empty_dir"], "traces"),
         Case("report: unrelated dir", ["report", "{t}/full_dir"], "traces"),
-        Case("report: run.json bytes", ["report", "{t}/run_nonutf8"], "run_nonutf8"),
+        Case("report: run.json bytes", ["report", "{t}/run_nonutf8"], "utf-8"),
         Case("report: run.json array", ["report", "{t}/run_garbage"], "run_garbage"),
         Case("report: a dataset", ["report", "{t}/ds"], "traces"),
         Case(

@@ -24,7 +24,7 @@ app = typer.Typer(
 )
 
 # command name -> module under rover.commands exposing `register(app)`
-COMMANDS = ["reason", "generate", "eval", "report", "demo", "annotate", "export"]
+COMMANDS = ["reason", "generate", "eval", "report", "demo", "validate", "annotate", "export"]
 
 
 def _version(value: bool) -> None:
@@ -91,6 +91,11 @@ def main() -> None:
             raise
         where = f": {exc.filename}" if exc.filename else ""
         print_error(f"{exc.strerror or type(exc).__name__}{where}", err)
+        sys.exit(2)
+    except UnicodeDecodeError as exc:  # a file that should be text is not; say so in a line
+        if debug:
+            raise
+        print_error(f"a file rover read is not UTF-8 text ({exc.reason} at byte {exc.start})", err)
         sys.exit(2)
     except (KeyboardInterrupt, typer.Abort):
         err.print("interrupted; rerun the same command (with --resume where offered) to continue")
