@@ -41,6 +41,7 @@ from rover.vlm.types import (
 
 T = TypeVar("T")
 _INLINE_PARSE_CHARS = 8192  # shorter replies parse in microseconds: no thread hop
+_INLINE_ENCODE_PIXELS = 1_000_000  # fewer pixels encode in ~1 ms: cheaper than a thread hop
 _ENCODE_LOCK = threading.Lock()  # the image memo is shared by every session's threads
 
 
@@ -120,7 +121,8 @@ class Session:
     async def prefetch(self, positions: list[int]) -> None:
         """Encode the frames a prompt will show in a worker thread (the loop stays free)."""
         todo = [p for p in dict.fromkeys(positions) if p not in self._parts]
-        if todo:
+        pixels = sum(_pixels(self.frames[p]) for p in todo)
+        if pixels > _INLINE_ENCODE_PIXELS:
             await asyncio.to_thread(lambda: [self.image(p) for p in todo])
 
     def params(self, frames: int) -> SamplingParams:
@@ -265,6 +267,14 @@ def is_oracle(vlm: VLM) -> bool:
         return True
     recorded = getattr(vlm, "recorded_models", None)
     return vlm.backend == "replay" and recorded == ["ground-truth"]
+
+
+def _pixels(frame: Any) -> int:
+    shape = getattr(frame, "shape", None)
+    if shape is not None and len(shape) >= 2:
+        return int(shape[0]) * int(shape[1])
+    size = getattr(frame, "size", None)  # PIL image
+    return int(size[0]) * int(size[1]) if isinstance(size, tuple) else _INLINE_ENCODE_PIXELS + 1
 
 
 def text(s: str) -> TextPart:
