@@ -1,6 +1,6 @@
 """Scripted-expert success rates: how often each task's expert solves a seeded scene.
 
-Usage: python benchmarks/expert_success.py [--seeds 20] [--tasks Lift,Door]
+Usage: python benchmarks/expert_success.py [--seeds 20] [--suite kitchen] [--tasks Lift,Door]
 Prints one row per task (successes / seeds, mean demo length, seconds per demo).
 """
 
@@ -20,12 +20,14 @@ from rover.sim.tasks import get_task, task_names
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--seeds", type=int, default=20)
-    ap.add_argument("--tasks", default=",".join(task_names()))
+    ap.add_argument("--suite", default="tabletop", help="tabletop, kitchen or all")
+    ap.add_argument("--tasks", default=None, help="comma-separated names (default: the suite)")
     args = ap.parse_args()
+    names = args.tasks.split(",") if args.tasks else task_names(args.suite)
     table = Table(title=f"Scripted expert success over {args.seeds} seeds")
     for col in ("task", "success", "rate", "mean steps", "s / demo"):
         table.add_column(col)
-    for name in args.tasks.split(","):
+    for name in names:
         sim = SimEnv(get_task(name))
         run_expert(sim, 10_000)  # warm-up (first episode per process is slow)
         ok, steps, start = 0, 0, time.perf_counter()

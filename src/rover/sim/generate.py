@@ -24,6 +24,7 @@ from pydantic import BaseModel
 from rover.episode import Episode, GroundTruth, StateType, Subtask, even_positions
 from rover.errors import InputError
 from rover.io.dataset import DatasetInfo, episode_ids, write_dataset_info, write_episode
+from rover.sim.kitchen.scene import scene_record
 from rover.sim.levels import LevelSpec, level_schedule, plan_seed
 from rover.sim.tasks import get_task
 from rover.sim.tasks.base import TaskSpec
@@ -236,9 +237,10 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
     )
     from rover.sim.env import CONTROL_FREQ
 
+    wording, instruction = spec.instruction(cfg.seed * 1_000_003 + item.index)
     episode = Episode(
         id=item.episode_id,
-        task=spec.description,
+        task=instruction,
         task_group=spec.group,
         source=f"sim:{spec.name}",
         fps=round(max(1.0, n * CONTROL_FREQ / max(len(roll), 1)), 3),
@@ -254,6 +256,8 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
             "level_name": level.name,
             "steps": len(roll),
             "deviation": _deviation_summary(roll),
+            "instruction": wording,  # which paraphrase `task` is (0 = the description)
+            **scene_record(sim),
         },
         views=frames,
     )

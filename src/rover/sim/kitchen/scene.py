@@ -111,3 +111,13 @@ def draw_scene(rng: np.random.Generator, used: list[str], decor: list[dict]) -> 
         camera_seed=int(rng.integers(2**31)),
         decor=decor,
     )
+
+
+def scene_record(sim) -> dict:
+    """``{"scene": ...}`` for ``episode.json`` when `sim` is a kitchen, else ``{}``.
+
+    Call it with the simulator reset to the episode's demonstration seed: the scene is
+    the one that seed drew (the one the episode's frames show).
+    """
+    scene = getattr(sim.env, "scene", None)
+    return {"scene": scene.to_json()} if isinstance(scene, Scene) else {}
