@@ -74,3 +74,15 @@ def test_export_refusals(exported, tmp_path):
     assert "valid formats: lerobot" in str(res.exception)
     res = CliRunner().invoke(app, ["export", str(tmp_path / "nope"), "--out", str(tmp_path / "o")])
     assert "no such dataset" in str(res.exception)
+
+
+def test_lerobot_itself_loads_the_export(exported):
+    """Where the lerobot package is installed, its own loader reads the export."""
+    lerobot_dataset = pytest.importorskip("lerobot.datasets.lerobot_dataset")
+    meta = lerobot_dataset.LeRobotDatasetMetadata("rover/bundled", root=exported)
+    assert meta.total_episodes == 12 and meta.total_frames == 360
+    assert meta.video_keys == ["observation.images.left", "observation.images.wrist"]
+    assert list(meta.tasks.index)[0] == "Pick up the red cube from the table and lift it."
+    ds = lerobot_dataset.LeRobotDataset("rover/bundled", root=exported, download_videos=False)
+    row = ds.hf_dataset[31]
+    assert int(row["episode_index"]) == 1 and int(row["frame_index"]) == 1
