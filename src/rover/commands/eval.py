@@ -193,7 +193,7 @@ def eval_command(
         backend_config=config,
         command=["rover"] + sys.argv[1:],
     )
-    err = Console(stderr=True, highlight=False)
+    err = make_console(stderr=True)
     progress = Progress(
         TextColumn("[bold]eval[/]"),
         BarColumn(),
@@ -273,4 +273,4 @@ def _build_report(run_dir: Path, err: Console) -> None:
         err.print("the report builder is not available in this build; skipped --report")
         return
     path = build_report(run_dir)
-    Console(highlight=False).print(f"report: {path}")
+    make_console().print(f"report: {esc(path)}")
