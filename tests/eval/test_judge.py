@@ -36,6 +36,34 @@ from rover.vlm.types import PromptMeta
         ("I am not sure.", "inconclusive", 0, 0),
         # the lists decide over a contradicting verdict line (App. C.2's definition)
         ("True statements: a\nFalse statements: b\nVerdict: true", "false", 1, 1),
+        # prose around the fields, an upper-case verdict
+        (
+            "Comparing with the ground truth:\n\nTrue statements: the can is lifted\n"
+            "False statements: none\n\nVerdict: TRUE. The rest is inconclusive.",
+            "true",
+            1,
+            0,
+        ),
+        # lists written as bullets under markdown headings
+        (
+            "### True statements:\n- the gripper is closed\n- the can is held\n"
+            "### False statements:\n- none\n### Verdict: true",
+            "true",
+            2,
+            0,
+        ),
+        # JSON in a code fence
+        (
+            '```json\n{"true_statements": [], "false_statements": ["the can is in bin 4"],'
+            ' "verdict": "false"}\n```',
+            "false",
+            0,
+            1,
+        ),
+        # cut off by max_tokens after both lists: the lists still decide
+        ("True statements: gripper open\nFalse statements: none\nVerd", "true", 1, 0),
+        # cut off before the false-statement list: nothing can be concluded
+        ("True statements: gripper open\nFalse sta", "inconclusive", 1, 0),
     ],
 )
 def test_parse_judge_reply(reply, verdict, n_true, n_false) -> None:

@@ -114,3 +114,40 @@ def test_rule_answerer_reads_turning_an_appliance_on_from_the_button() -> None:
         object="button",
     )
     assert first_event_position(on, states, []) == 2
+
+
+def test_rule_answerer_reads_model_style_sequences() -> None:
+    """Drops belong to the object dropped; intentions are not events; target bins."""
+    task = "Restock the shelf: put the milk in bin 1 and the can in bin 4."
+    descriptions = [
+        "The robot is preparing to grasp the soda can.",
+        "The gripper grabs the milk carton and lifts it.",
+        "The robot drops the carton of milk.",
+        "The can has been placed in the target bin.",
+    ]
+    states = asserted_states(descriptions, task=task)
+
+    def ask(event: str, obj: str, target: str = "") -> int | None:
+        where = f" in {target}" if target else ""
+        item = QAItem(
+            question=f"Did the robot {event} the {obj}{where}?",
+            answer=True,
+            event=event,
+            object=obj,
+        )
+        qa = [
+            QAItem(
+                question=f"Did the robot place the {obj} in {target or 'bin 4'}?",
+                answer=True,
+                event="place",
+                object=obj,
+            )
+        ]
+        return first_event_position(item, states, qa)
+
+    assert ask("contact", "can") is None  # "preparing to grasp" is not a contact
+    assert ask("pick_up", "milk") == 1
+    assert ask("drop", "milk", "bin 1") == 2
+    assert ask("drop", "can", "bin 4") is None  # the milk was dropped, not the can
+    assert ask("place", "can", "bin 4") == 3
+    assert ask("place", "milk", "bin 1") is None

@@ -209,3 +209,69 @@ def test_every_oracle_sentence_on_the_bundled_dataset_is_checked() -> None:
                 found += len(judge_description(noisy, facts).false_claims)
             frames += 1
     assert frames > 0 and flips > 0 and found == flips
+
+
+LIFTED_CAN = FrameFacts(
+    gripper="closed",
+    contacts=["can"],
+    holding="can",
+    objects={"can": ObjectFacts(lifted=True)},
+)
+STACKED = FrameFacts(
+    gripper="open",
+    objects={
+        "red cube": ObjectFacts(on="green cube"),
+        "green cube": ObjectFacts(on="table"),
+    },
+)
+HALF_DOOR = FrameFacts(
+    gripper="closed", holding="door", contacts=["door"], articulations={"door": 0.6}
+)
+
+
+@pytest.mark.parametrize(
+    ("text", "facts", "verdict"),
+    [
+        # aliases, hedges, pronouns, markdown, compound verbs
+        (
+            "**Frame description:** The soda can is held securely in the gripper.",
+            LIFTED_CAN,
+            "true",
+        ),
+        ("The gripper appears to be open.", LIFTED_CAN, "false"),
+        ("The robot grips the can and lifts it off the table.", LIFTED_CAN, "true"),
+        ("- Gripper: closed\n- Can: lifted", LIFTED_CAN, "true"),
+        ("Gripper empty, the can rests on the table.", LIFTED_CAN, "false"),
+        ("The robot is about to release the can.", LIFTED_CAN, "inconclusive"),
+        ("The arm is moving toward the bin.", LIFTED_CAN, "inconclusive"),
+        ("The red block is stacked on top of the green block.", STACKED, "true"),
+        ("The green block sits on the red block.", STACKED, "false"),
+        ("The robot is holding the red block.", STACKED, "false"),
+        ("The door is about halfway open and the robot grips its handle.", HALF_DOOR, "true"),
+        ("The door remains shut.", HALF_DOOR, "false"),
+        ("The door is fully open.", HALF_DOOR, "false"),
+    ],
+)
+def test_model_style_descriptions(text: str, facts: FrameFacts, verdict: str) -> None:
+    assert judge_description(text, facts).verdict == verdict
+
+
+def test_the_target_bin_is_the_one_the_task_names() -> None:
+    facts = FrameFacts(
+        objects={"can": ObjectFacts(inside="bin 4"), "milk": ObjectFacts(inside="bin 1")}
+    )
+    task = "Restock the shelf: put the milk in bin 1 and the can in bin 4."
+    assert judge_description("The can is in the target bin.", facts, task).verdict == "true"
+    assert judge_description("The milk carton sits in its goal bin.", facts, task).verdict == (
+        "true"
+    )
+    assert judge_description("The can is still in the start bin.", facts, task).verdict == ("false")
+    # without the task the target is unknown: nothing decided
+    assert judge_description("The can is in the target bin.", facts).verdict == "inconclusive"
+
+
+def test_names_tell_objects_apart() -> None:
+    assert names_match("red block", "red cube") and names_match("milk carton", "milk")
+    assert names_match("dial", "knob") and names_match("door handle", "door")
+    assert not names_match("green block", "red cube")
+    assert not names_match("bin 4", "bin 1")

@@ -153,14 +153,14 @@ def parse_judge_reply(text: str) -> FrameJudgement:
         if line.strip():
             current = None
     v = _VERDICT.search(text.replace("**", ""))
+    parsed = _json_reply(text) if not seen else None
     if seen == {"true", "false"}:
         verdict = frame_verdict(len(lists["true"]), len(lists["false"]))
+    elif parsed is not None:
+        return parsed
     elif v:
         verdict = v.group(1).lower()
     else:
-        parsed = _json_reply(text)
-        if parsed is not None:
-            return parsed
         verdict = "false" if lists["false"] else "inconclusive"
     return FrameJudgement(verdict, lists["true"], lists["false"], text.strip()[:500])  # type: ignore[arg-type]
 
