@@ -20,8 +20,12 @@ import pytest
 from rover.episode import Episode, QAItem, StateType
 from rover.eval.judge import rule_judge_trace
 from rover.eval.qa import rule_answer_trace
+from rover.eval.results import compute_metrics, write_results
+from rover.eval.rundir import RunDir, write_json_atomic
+from rover.eval.variants import expand_variants
 from rover.io.dataset import DatasetInfo, write_dataset_info, write_episode
 from rover.methods.trace import CallRecord, FrameRecord, LineNode, Trace
+from rover.run.store import write_thumbs
 
 INJECTION = "<script>document.title='pwned'</script>"
 
@@ -126,7 +130,8 @@ def _trace(
 
 @pytest.fixture
 def make_run(tmp_path: Path, make_episode):
-    """Factory: a run directory (traces + run.json naming a real dataset directory)."""
+    """Factory: a run directory in rover eval's layout: run.json, episodes/, frames/,
+    traces, real rule-judge verdicts and QA answers, and metrics.json from the scorer."""
 
     def _make(
         backend: str = "oracle", name: str = "run", injection: bool = True, judged: bool = True
@@ -175,7 +180,26 @@ def make_run(tmp_path: Path, make_episode):
             episodes.append(ep)
         run = root / "runs" / "r1"
         (run / "traces").mkdir(parents=True)
-        (run / "run.json").write_text(json.dumps({"dataset": str(dataset)}))
+        variants = expand_variants(
+            ["rover", "gvl", "temporal-concat"], [backend], [None], [None], [None]
+        )
+        config = {
+            "schema_version": 1,
+            "dataset": str(dataset),
+            "sources": [],
+            "episodes": [ep.id for ep in episodes],
+            "episode_datasets": {ep.id: "tiny" for ep in episodes},
+            "methods": [v.method for v in variants],
+            "backends": [backend],
+            "judge": "rule" if judged else "none",
+            "answerer": "rule" if judged else "none",
+            "variants": [v.model_dump(mode="json") for v in variants],
+        }
+        (run / "run.json").write_text(json.dumps(config))
+        rundir = RunDir(run)
+        for ep in episodes:  # what rover eval keeps of each episode: metadata and small frames
+            write_json_atomic(rundir.episode_path(ep.id), ep.model_copy(update={"views": {}}))
+            write_thumbs(run, ep.id, ep.view, ep.frames(), ep.frame_indices)
         for ep in episodes:
             for method in ("rover", "gvl", "temporal-concat"):
                 override = INJECTION if injection and method == "rover" and ep.id == "ep0" else None
@@ -191,6 +215,7 @@ def make_run(tmp_path: Path, make_episode):
                     ):
                         (run / folder / ep.id).mkdir(parents=True, exist_ok=True)
                         (run / folder / ep.id / f"{vid}.json").write_text(result.model_dump_json())
+        write_results(rundir, compute_metrics(rundir, config))
         return run
 
     return _make
@@ -211,6 +236,7 @@ class PageResult:
     errors: list[str]  # console errors, exceptions, failed loads
     broken_images: list[str]
     screenshot: bytes
+    checks: dict = None  # type: ignore[assignment]  # name -> value of a JS expression
 
 
 class _CDP:
@@ -277,10 +303,10 @@ def _errors(events: list[dict]) -> list[str]:
 def open_in_chromium(tmp_path: Path):
     """Load a local HTML file in headless Chromium and report what a reader would see."""
 
-    def _open(page: Path) -> PageResult:
+    def _open(page: Path, checks: dict[str, str] | None = None) -> PageResult:
         from websockets.sync.client import connect
 
-        profile = tmp_path / "chromium-profile"
+        profile = tmp_path / f"chromium-profile-{len(list(tmp_path.glob('chromium-profile-*')))}"
         proc = subprocess.Popen(
             [
                 CHROMIUM,
@@ -309,7 +335,7 @@ def open_in_chromium(tmp_path: Path):
                 time.sleep(0.1)
             port, path = port_file.read_text().splitlines()[:2]
             with connect(f"ws://127.0.0.1:{port}{path}", max_size=None, open_timeout=30) as ws:
-                return _drive(_CDP(ws), page)
+                return _drive(_CDP(ws), page, checks or {})
         finally:
             proc.terminate()
             try:
@@ -320,7 +346,7 @@ def open_in_chromium(tmp_path: Path):
     return _open
 
 
-def _drive(cdp: _CDP, page: Path) -> PageResult:
+def _drive(cdp: _CDP, page: Path, checks: dict[str, str]) -> PageResult:
     target = cdp.send("Target.createTarget", {"url": "about:blank"})["targetId"]
     session = cdp.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
     for domain in ("Runtime", "Log", "Page", "Network"):
@@ -345,6 +371,7 @@ def _drive(cdp: _CDP, page: Path) -> PageResult:
     })""")
     cdp.drain(0.5)
     shot = cdp.send("Page.captureScreenshot", {"format": "png"}, session=session)
+    results = {name: js(expr) for name, expr in checks.items()}  # after the screenshot
     return PageResult(
         title=js("document.title"),
         text=js("document.body.innerText"),
@@ -352,4 +379,5 @@ def _drive(cdp: _CDP, page: Path) -> PageResult:
         errors=_errors(cdp.events),
         broken_images=broken,
         screenshot=base64.b64decode(shot["data"]),
+        checks=results,
     )

@@ -25,10 +25,11 @@ def test_oracle_report(make_run, tmp_path: Path) -> None:
     index = build_report(run, tmp_path / "report")
     page = index.read_text()
     _check_figures(index, page)
-    _check_escaping(page)
-    _check_oracle_labels(page)
-    _check_viewer(index, page)
+    _check_escaping(index, page)
+    _check_oracle_labels(index, page)
+    _check_viewer(run, index, page)
     _check_summary(run, page)
+    _check_exports(run, index)
 
 
 def _check_figures(index: Path, page: str) -> None:
@@ -60,20 +61,31 @@ def _check_figures(index: Path, page: str) -> None:
         assert f"figures/{stem}.svg" in page
 
 
-def _check_escaping(page: str) -> None:
-    assert "<script" not in page.lower()
-    assert str(escape("<script>document.title='pwned'</script>")) in page
+def _episode_pages(index: Path) -> dict[str, str]:
+    return {p.stem: p.read_text() for p in sorted((index.parent / "episodes").glob("*.html"))}
+
+
+def _check_escaping(index: Path, page: str) -> None:
+    # the main page carries one script of ours (table sorting); model text is never markup
+    assert page.lower().count("<script") == 1
+    pages = _episode_pages(index)
+    assert set(pages) == {"ep0", "ep1", "ep2"}
+    for text in pages.values():
+        assert "<script" not in text.lower()
+    assert str(escape("<script>document.title='pwned'</script>")) in pages["ep0"]
     # subtasks in the reasoning tree are model text too
-    assert "grasp the &lt;b&gt;can&lt;/b&gt;" in page
-    assert "plan: grasp the &lt;b&gt;can&lt;/b&gt; → place the can in the bin" in page
+    assert "grasp the &lt;b&gt;can&lt;/b&gt;" in pages["ep0"]
+    assert "plan: grasp the &lt;b&gt;can&lt;/b&gt; → place the can in the bin" in pages["ep0"]
 
 
-def _check_oracle_labels(page: str) -> None:
-    assert 'id="oracle-banner"' in page
+def _check_oracle_labels(index: Path, page: str) -> None:
+    assert page.count('id="oracle-banner"') == 1
     assert "ORACLE OUTPUT — answers come from simulator ground truth, not a VLM" in page
     assert "oracle:oracle" in page  # the backend is named
-    # every section and every method in the viewer carries the label
-    assert page.count('class="badge oracle"') >= 4 + 3 * 3
+    # one banner, then one badge per section, not one per method and episode
+    assert page.count('class="badge oracle"') == 4  # summary, figures, tables, episodes
+    for text in _episode_pages(index).values():
+        assert text.count('id="oracle-banner"') == 1 and 'class="badge oracle"' not in text
 
 
 def test_report_command_without_oracle(make_run, tmp_path: Path) -> None:
@@ -93,28 +105,67 @@ def test_report_command_without_oracle(make_run, tmp_path: Path) -> None:
     assert bad.exit_code != 0
 
 
-def _check_viewer(index: Path, page: str) -> None:
-    thumbs = re.findall(r'<img src="(frames/[^"]+)"', page)
-    assert len(thumbs) == 30  # 3 episodes x 10 frames
-    for src in thumbs:
-        with Image.open(index.parent / src) as im:
-            assert im.format == "JPEG" and max(im.size) <= 112
-    assert page.count("<polyline") == 3 * 4  # per episode: ground truth + 3 methods
-    assert 'class="tree"' in page and "frames 0–4" in page
+def _check_viewer(run: Path, index: Path, page: str) -> None:
+    pages = _episode_pages(index)
+    for text in pages.values():
+        thumbs = re.findall(r'<img src="\.\./(frames/[^"]+)"', text)
+        assert len(thumbs) == 10  # every frame the traces predicted, from the run's own frames
+        for src in thumbs:
+            with Image.open(index.parent / src) as im:
+                assert im.format == "JPEG" and max(im.size) <= 112
+        assert text.count("<polyline") == 4  # ground truth + 3 methods
+        assert "frame index (original video)" in text and "task progress (%)" in text
+        # every curve has a legend checkbox that hides it (CSS only)
+        for i in range(3):
+            assert f'id="show-{i}"' in text and f'class="curve-{i}"' in text
+        assert not re.search(r"\b1 calls\b", text)
+    text = pages["ep0"]
+    assert 'class="tree"' in text and "frames 0–4" in text
     # the temporal-concat perception error is judged false and shown so
-    assert 'class="v-false"' in page and 'class="v-true"' in page
-    assert 'class="v-inconclusive"' in page
+    assert 'class="v-false"' in text and 'class="v-true"' in text
+    assert 'class="v-inconclusive"' in text
+    # the main page shows the most informative episode (methods disagree most) first
+    m = json.loads((run / "metrics.json").read_text())
+    by_ep: dict[str, list[float]] = {}
+    for r in m["per_trace"]:
+        by_ep.setdefault(r["episode_id"], []).append(r["pearson"])
+    top = max(by_ep, key=lambda e: max(by_ep[e]) - min(by_ep[e]))
+    assert (
+        f'<iframe class="episode" name="episode" title="episode viewer" src="episodes/{top}.html"'
+        in page
+    )
+    assert page.count('target="episode"') == 3
 
 
 def _check_summary(run: Path, page: str) -> None:
+    """The page's main table is summary.md's, cell for cell."""
+    summary = (run / "summary.md").read_text()
+    md_row = next(line for line in summary.splitlines() if line.startswith("| ROVER |"))
+    cells = [c.strip() for c in md_row.strip("|").split("|")]
+    html_row = re.search(r"ROVER</td>(.*?)</tr>", page, re.S).group(1)
+    assert re.findall(r'<td class="num">([^<]*)</td>', html_row) == cells[1:]
     dataset = Path(json.loads((run / "run.json").read_text())["dataset"])
     rs = []
     for ep_dir in sorted((run / "traces").iterdir()):
         trace = Trace.load(next(ep_dir.glob("rover__*.json")))
         rs.append(score_progress(trace, read_episode(dataset, ep_dir.name, load_frames=False)))
     mean = sum(s.pearson for s in rs) / len(rs)
-    row = re.search(r"ROVER</td>(.*?)</tr>", page, re.S)
-    assert row and f"{mean:.2f} ±" in row.group(1)
+    assert f"{mean:.2f} ±" in cells[1]
+
+
+def _check_exports(run: Path, index: Path) -> None:
+    import csv
+
+    with open(index.parent / "predictions.csv", newline="") as fh:
+        preds = list(csv.DictReader(fh))
+    assert len(preds) == 3 * 3 * 10  # episodes x methods x frames
+    injected = [p for p in preds if p["description"].startswith("<script>")]
+    assert len(injected) == 1 and injected[0]["episode_id"] == "ep0"
+    with open(index.parent / "episodes.csv", newline="") as fh:
+        eps = list(csv.DictReader(fh))
+    m = json.loads((run / "metrics.json").read_text())
+    assert len(eps) == len(m["per_trace"]) == 9
+    assert {float(e["pearson"]) for e in eps} == {r["pearson"] for r in m["per_trace"]}
 
 
 def test_missing_run_dir_is_an_input_error(tmp_path: Path) -> None:

@@ -24,13 +24,22 @@ def report(
     ] = None,
     dataset: Annotated[
         Path | None,
-        typer.Option("--dataset", help="Dataset directory of the run, if run.json lacks it."),
+        typer.Option(
+            "--dataset",
+            help="Only for runs made before rover kept frames in the run: where they are.",
+        ),
     ] = None,
     max_episodes: Annotated[
-        int, typer.Option("--max-episodes", min=0, help="Episodes shown in the viewer.")
-    ] = 40,
+        int,
+        typer.Option(
+            "--max-episodes",
+            min=0,
+            help="Episode pages to write, most informative first (0: all).",
+        ),
+    ] = 0,
 ) -> None:
-    """Draw the paper's figures (PNG + SVG) and write one HTML page with an episode viewer."""
+    """Draw the paper's figures (PNG + SVG), write the HTML report with one page per
+    episode, and export per-frame predictions and per-episode scores as CSV."""
     from rover.report import build_report
 
     if not run_dir.is_dir():

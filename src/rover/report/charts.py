@@ -121,7 +121,7 @@ def time_diff_hist(rows, variants, colors) -> Figure:
     """Per method: a histogram as a row of dots (one per question) over a box of quartiles.
 
     Overlaid histograms of eight methods hide each other; one row per method keeps every
-    distribution visible and still reads like the paper's histogram (App. A, Fig. 3).
+    distribution visible and still reads like the paper's histogram (Fig. 6).
     """
     diffs_by = {v: [d for r in rows if r.series == v for d in r.qa_time_diffs] for v in variants}
     shown = [v for v in variants if diffs_by[v]]
@@ -253,7 +253,7 @@ def _group_order(group: str) -> tuple[int, str]:
 
 
 def strata_bars(agg: list[dict], label: str, variants: list[str], colors: dict[str, str]) -> Figure:
-    """Two panels of precomputed means: (a) by frames in context, (b) by state type (App. G).
+    """Two panels of precomputed means: (a) by frames in context, (b) by state type (App. H).
 
     `agg` rows: {"series", "by" ("context" | "state_type"), "group", "mean", "se"}.
     """

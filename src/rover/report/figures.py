@@ -1,4 +1,4 @@
-"""The paper's kinds of figures (Sec. 5, App. A, F, H, I, M), drawn with matplotlib.
+"""The paper's kinds of figures (Sec. 5, App. A, F, H, I, J, M), drawn with matplotlib.
 
 Figures are built on `matplotlib.figure.Figure` directly (the Agg canvas, no pyplot and no
 global backend state), and each is written as PNG and SVG. A figure is drawn only when the
@@ -14,6 +14,7 @@ from pathlib import Path
 from matplotlib import rc_context
 from matplotlib.figure import Figure
 
+from rover.methods.info import method_info
 from rover.report import charts
 from rover.report.charts import PALETTE
 from rover.report.scores import EpisodeScore, variants_in_order
@@ -92,17 +93,31 @@ STRATA: dict[str, tuple[str, str, float, str]] = {
     "error_rate": (
         "reasoning",
         "Reasoning error rate (%)",
-        100.0,
+        1.0,  # metrics.json rates are percentages already
         "Frame reasoning by context length and state type",
     ),
 }
 
 
 def variant_colors(rows: list[EpisodeScore]) -> dict[str, str]:
-    """One fixed colour per configuration (and per series), shared by figures and viewer."""
-    colors = {v: PALETTE[i % len(PALETTE)] for i, v in enumerate(variants_in_order(rows))}
-    for i, name in enumerate(variants_in_order(rows, "series")):
-        colors.setdefault(name, PALETTE[i % len(PALETTE)])
+    """One fixed colour per configuration and per series, shared by tables, figures and
+    viewer: a method's registry colour for its first configuration, spare colours after."""
+    colors: dict[str, str] = {}
+    used: set[str] = set()
+
+    def pick(preferred: str) -> str:
+        if preferred not in used:
+            return preferred
+        return next((c for c in PALETTE if c not in used), preferred)
+
+    for r in rows:
+        if r.series not in colors:
+            colors[r.series] = pick(method_info(r.method).color)
+            used.add(colors[r.series])
+        if r.variant not in colors:
+            same = [k for k, c in colors.items() if c == colors[r.series] and k != r.series]
+            colors[r.variant] = colors[r.series] if not same else pick(colors[r.series])
+            used.add(colors[r.variant])
     return colors
 
 
@@ -137,14 +152,14 @@ def _write_figures(
     written: list[FigureFile] = []
     # The paper's main figures compare methods at one setting; sweeps get their own figures.
     frames0, view0 = _primary_setting(rows)
-    at_view = [r for r in rows if r.view == view0]
-    at_frames = [r for r in rows if r.num_frames == frames0]
-    main = [r for r in at_frames if r.view == view0]
+    at_view = [r for r in rows if r.setting_view == view0]
+    at_frames = [r for r in rows if r.setting_frames == frames0]
+    main = [r for r in at_frames if r.setting_view == view0]
     series = variants_in_order(main, "series")
     note = ""
     if len(main) < len(rows):
         note = (
-            f" Shown at {frames0} frames per video, view {view0 or 'default'}; other "
+            f" Shown at {frames0 or 'all'} frames per video, view {view0 or 'own'}; other "
             "settings are in the sweep figures and the summary table."
         )
 
@@ -187,14 +202,14 @@ def _write_figures(
                 title,
                 "Mean and standard error over videos, per frame stratum: how many "
                 "frames the method had in context when it predicted a frame, and the state "
-                "type at that frame (App. G). From metrics.json." + note,
+                "type at that frame (App. H). From metrics.json." + note,
             )
 
     if any(r.qa_time_diffs for r in main):
         save(
             charts.time_diff_hist(main, series, colors),
             "qa_temporal_distance",
-            "Video QA: temporal distance",
+            "Video QA: temporal distance (Fig. 6)",
             "Frames between when a method's descriptions say an event happened and when it "
             "did (negative: stated too early). Only questions answered yes correctly." + note,
         )
@@ -216,7 +231,7 @@ def _write_figures(
             "progress, by the share of non-expert states in the video (App. A.1). Accurate "
             "reasoning should track frame number less as the share grows." + note,
         )
-    if len({r.num_frames for r in at_view}) > 1 and any(r.pearson is not None for r in at_view):
+    if len({r.setting_frames for r in at_view}) > 1 and any(r.pearson is not None for r in at_view):
         save(
             charts.line_by(
                 at_view,
@@ -229,25 +244,26 @@ def _write_figures(
                 attr="series",
             ),
             "pearson_by_frame_count",
-            "Robustness to frame count",
+            "Robustness to frame count (App. I)",
             "Mean and standard error of the correlation with ground truth as the same videos "
-            "are sampled with more frames (App. H).",
+            "are sampled with more frames (App. I).",
         )
-    if len({r.view for r in at_frames}) > 1 and any(r.pearson is not None for r in at_frames):
+    swept_views = len({r.setting_view for r in at_frames}) > 1
+    if swept_views and any(r.pearson is not None for r in at_frames):
         fig = charts.bars(
             at_frames,
             "pearson",
             "Pearson r with ground truth",
             variants_in_order(at_frames, "series"),
             colors,
-            lambda r: r.view or "default",
+            lambda r: r.setting_view or "own",
             "Camera view",
             attr="series",
         )
         save(
             fig,
             "pearson_by_view",
-            "Robustness to camera view",
+            "Robustness to camera view (App. J)",
             "Mean and standard error of the correlation with ground truth by camera view.",
         )
     window_rows = [r for r in main if r.method == "rover" and r.window]
@@ -262,18 +278,18 @@ def _write_figures(
         save(
             charts.cost_bars(at_view, variants_in_order(at_view, "series"), colors),
             "cost_tokens",
-            "Inference cost",
+            "Inference cost (App. F)",
             "Mean tokens per video (bars, left) and VLM calls per video (labels), by "
             "method and frame count (App. F).",
         )
     return written
 
 
-def _primary_setting(rows: list[EpisodeScore]) -> tuple[int, str | None]:
+def _primary_setting(rows: list[EpisodeScore]) -> tuple[int | None, str | None]:
     """The frame count and view most traces share (ties: more frames, first view)."""
-    frames = [r.num_frames for r in rows]
-    frames0 = max(set(frames), key=lambda n: (frames.count(n), n))
-    views = [r.view for r in rows if r.num_frames == frames0]
+    frames = [r.setting_frames for r in rows]
+    frames0 = max(set(frames), key=lambda n: (frames.count(n), n or 10**9))
+    views = [r.setting_view for r in rows if r.setting_frames == frames0]
     order = list(dict.fromkeys(views))
     view0 = max(order, key=lambda v: (views.count(v), -order.index(v)))
     return frames0, view0

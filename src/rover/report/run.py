@@ -1,17 +1,15 @@
-"""Everything the report reads from a run directory, in one place.
+"""Everything the report reads from a run directory, through `rover.run.store.RunStore`.
 
-The layout is the evaluation runner's (docs/evaluation.md): `run.json`,
-`traces/<episode>/<variant>.json`, `judgements/...` and `qa/...` beside them. The report
-depends on as little of it as it can: every `*.json` under the run that parses as a
-`Trace` is a trace (its file stem is its variant id), and the dataset is the one
-`run.json` names (or one given explicitly). With traces plus the dataset's episodes the
-report recomputes every progress and cost number itself; judge verdicts and video-QA
-answers are shown when the run recorded them.
+The report draws numbers, it never computes them: per-video scores and aggregates come
+from the run's metrics.json (rescored by the one scorer when it is missing or outdated);
+traces, verdicts and QA answers are read for the episode viewer only. Episodes' ground
+truth and the frames the viewer shows are the run's own copies (`episodes/`, `frames/`),
+so `rover report RUN` needs nothing outside RUN, on simulated and real data alike. An
+older run without saved frames falls back to the dataset `run.json` names, if present.
 """
 
 from __future__ import annotations
 
-import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,26 +19,14 @@ from pydantic import ValidationError
 
 from rover.episode import Episode
 from rover.errors import InputError
-from rover.io.dataset import DATASET_FILE, episode_ids, read_episode
+from rover.io.dataset import DATASET_FILE, read_episode
+from rover.methods.info import method_info, method_rank
 from rover.methods.trace import Trace
+from rover.run.store import RunStore, write_thumbs
 
 log = logging.getLogger(__name__)
 
 RUN_CONFIG = "run.json"  # written by `rover eval` (docs/evaluation.md)
-
-DISPLAY_NAMES = {
-    "rover": "ROVER",
-    "rover-no-window": "ROVER w/o window",
-    "rover-no-recursion": "ROVER w/o recursion",
-    "gvl": "GVL",
-    "gvl-single": "GVL (single call)",
-    "temporal-concat": "TemporalConcat",
-    "local-concat": "LocalConcat",
-    "video-concat": "VideoConcat",
-    "clip-value": "CLIP value",
-}
-METHOD_ORDER = list(DISPLAY_NAMES)
-DEFAULT_WINDOW = 3
 
 
 @dataclass
@@ -58,20 +44,24 @@ class QAResult:
     question: str
     truth: bool
     predicted: bool | None
-    truth_frame: int | None = None  # original frame index (or position) the event happened
+    truth_frame: int | None = None
     predicted_frame: int | None = None
     template: str = ""
 
 
 @dataclass
 class TraceEntry:
-    """One trace file: the trace, its variant id (file stem) and its display labels."""
+    """One scored (episode, variant): its trace, its metrics row and display labels."""
 
     trace: Trace
     variant_id: str
     path: Path
-    label: str = ""  # full configuration name, e.g. "ROVER (window 6) · 60 frames"
-    series: str = ""  # the same without frame count and view (for App. H / I figures)
+    row: dict[str, Any]
+    label: str = ""  # the variant's label, e.g. "ROVER (window 6) · 60 frames"
+    series: str = ""  # the same without frame count (for App. I figures)
+    view: str = ""  # the camera the trace saw (a column, never part of the label)
+    setting_view: str | None = None  # the view the variant asked for (None: each video's own)
+    setting_frames: int | None = None  # the frame count it asked for (None: all frames)
 
     @property
     def key(self) -> tuple[str, str]:
@@ -80,19 +70,21 @@ class TraceEntry:
 
 @dataclass
 class RunData:
-    """A run directory read into memory: traces, episodes (metadata), optional judgements."""
+    """A run directory read into memory for drawing."""
 
     run_dir: Path
+    store: RunStore
+    config: dict[str, Any]
+    metrics: dict[str, Any]
     entries: list[TraceEntry]
-    dataset: Path | None
+    dataset: Path | None = None
     episodes: dict[str, Episode] = field(default_factory=dict)
-    # (variant id, episode id) -> original frame index -> verdict
     verdicts: dict[tuple[str, str], dict[int, FrameVerdict]] = field(default_factory=dict)
     qa: dict[tuple[str, str], list[QAResult]] = field(default_factory=dict)
-    config: dict[str, Any] = field(default_factory=dict)
-    # metrics.json's long-form aggregate rows, for the frame-level strata (App. G) that
-    # only the evaluation computes; empty when the run has no metrics.json
-    aggregates: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def aggregates(self) -> list[dict[str, Any]]:
+        return self.metrics.get("aggregates", [])
 
     @property
     def traces(self) -> list[Trace]:
@@ -100,138 +92,113 @@ class RunData:
 
     @property
     def backends(self) -> list[str]:
-        """Every backend/model pair the traces were made with, e.g. 'oracle (oracle)'."""
+        """Every backend/model pair the traces were made with, e.g. 'oracle:oracle'."""
         return sorted({f"{t.backend}:{t.model}" if t.model else t.backend for t in self.traces})
 
     @property
     def oracle(self) -> bool:
         return any(t.oracle or t.backend == "oracle" for t in self.traces)
 
-    def episode_frames(self, episode_id: str, view: str | None) -> Episode | None:
-        """The episode with one view's pixels, or None when the dataset is not at hand."""
-        if self.dataset is None or episode_id not in self.episodes:
-            return None
-        ep = self.episodes[episode_id]
-        name = view if view in ep.view_names else ep.view
+    def thumbs(self, episode_id: str, view: str | None) -> dict[int, Path]:
+        """Original frame index -> small JPEG, from the run (or, for old runs, the dataset)."""
+        found = self.store.thumbs(episode_id, view)
+        if found or self.dataset is None:
+            return found
+        ep = self.episodes.get(episode_id)
+        name = view if ep is not None and view in ep.view_names else (ep.view if ep else None)
         try:
-            return read_episode(self.dataset, episode_id, views=[name])
+            full = read_episode(self.dataset, episode_id, views=[name] if name else None)
         except InputError as exc:
             log.warning("no frames for %s: %s", episode_id, exc)
-            return None
+            return {}
+        write_thumbs(self.run_dir, episode_id, full.view, full.frames(), full.frame_indices)
+        return self.store.thumbs(episode_id, full.view)
 
 
-def _label_entries(entries: list[TraceEntry]) -> None:
-    """Name configurations by what actually varies in this run, nothing more."""
-    traces = [e.trace for e in entries]
-    multi_model = len({(t.backend, t.model) for t in traces}) > 1
-    multi_frames = len({t.num_frames for t in traces}) > 1
-    multi_view = len({t.view for t in traces}) > 1
-    for e in entries:
-        t = e.trace
-        name = DISPLAY_NAMES.get(t.method, t.method)
-        window = t.params.get("window")
-        if t.method in ("rover", "rover-no-recursion") and window not in (None, DEFAULT_WINDOW):
-            name = f"{name} (window {window})"
-        if multi_model:
-            name = f"{name} [{t.model or t.backend}]"
-        e.series = name
-        if multi_frames:
-            name = f"{name} · {t.num_frames} frames"
-        if multi_view:
-            name = f"{name} · {t.view or 'default view'}"
-        e.label = name
-
-
-def entry_sort_key(e: TraceEntry) -> tuple[int, int, str, int, str]:
-    t = e.trace
-    order = METHOD_ORDER.index(t.method) if t.method in METHOD_ORDER else len(METHOD_ORDER)
-    window = t.params.get("window")
-    return (
-        order,
-        int(window) if isinstance(window, int) else 0,
-        t.model,
-        t.num_frames,
-        t.view or "",
-    )
+def series_name(variant: dict[str, Any], backends: set[str]) -> str:
+    """The variant's label without its frame count (the lines of an App. I figure)."""
+    info = method_info(variant["method"])
+    name = info.display
+    w = variant.get("window")
+    if w is not None and w != info.default_window:
+        name += f" (window {w})"
+    if len(backends) > 1:
+        name += f" [{variant['backend']}]"
+    return name
 
 
 def load_run(run_dir: Path, dataset: Path | None = None) -> RunData:
-    """Read a run directory; `dataset` overrides the dataset the run's config names."""
+    """Read a run directory written by `rover eval`; `dataset` is an old-run frame fallback."""
     run_dir = Path(run_dir)
-    if not run_dir.is_dir():
-        raise InputError(f"{run_dir}: no such run directory")
-    entries = _load_traces(run_dir)
+    store = RunStore(run_dir)
+    if not store.has_config:
+        raise InputError(
+            f"{run_dir}: no traces found (no {RUN_CONFIG}; expected a run directory "
+            "written by rover eval)"
+        )
+    config = store.config()
+    if not config.get("variants") or "episodes" not in config:
+        raise InputError(
+            f"{run_dir / RUN_CONFIG}: lists no variants or episodes (written by an older "
+            "rover?); rerun rover eval with --resume to rewrite it"
+        )
+    metrics = store.metrics()
+    variants = {v["id"]: v for v in metrics.get("variants", [])}
+    backends = {v["backend"] for v in variants.values()}
+    entries: list[TraceEntry] = []
+    for row in metrics.get("per_trace", []):
+        if row.get("error") is not None:
+            continue
+        path = store.stage_file("trace", row["episode_id"], row["variant"])
+        try:
+            trace = Trace.load(path)
+        except (OSError, ValidationError, ValueError) as exc:
+            log.warning("skipping %s: not a readable trace (%s)", path, exc)
+            continue
+        v = variants.get(row["variant"], {"method": trace.method, "backend": trace.backend})
+        entries.append(
+            TraceEntry(
+                trace=trace,
+                variant_id=row["variant"],
+                path=path,
+                row=row,
+                label=row.get("label") or v.get("label") or row["variant"],
+                series=series_name({**v, "method": row["method"]}, backends),
+                view=str(row.get("view") or trace.view or ""),
+                setting_view=v.get("view"),
+                setting_frames=v.get("frames"),
+            )
+        )
     if not entries:
-        raise InputError(f"{run_dir}: no traces found (expected traces/**/*.json from rover eval)")
-    entries.sort(key=entry_sort_key)
-    _label_entries(entries)
-    config = _load_config(run_dir)
-    ds = Path(dataset) if dataset is not None else _dataset_from_config(run_dir, config)
-    run = RunData(run_dir=run_dir, entries=entries, dataset=ds, config=config)
-    run.aggregates = _load_aggregates(run_dir / "metrics.json")
-    if ds is not None:
-        if not (ds / DATASET_FILE).exists():
-            raise InputError(f"{ds}: not a rover dataset directory (no {DATASET_FILE})")
-        wanted = {e.trace.episode_id for e in entries}
-        for eid in episode_ids(ds):
-            if eid in wanted:
-                run.episodes[eid] = read_episode(ds, eid, load_frames=False)
-    else:
-        log.warning("dataset of %s not found: ground-truth figures are skipped", run_dir)
+        raise InputError(f"{run_dir}: no traces found (no finished work unit in the run)")
+    order = {vid: i for i, vid in enumerate(variants)}
+    entries.sort(key=lambda e: (method_rank(e.trace.method), order.get(e.variant_id, 0)))
+    run = RunData(
+        run_dir=run_dir,
+        store=store,
+        config=config,
+        metrics=metrics,
+        entries=entries,
+        dataset=_dataset(run_dir, config, dataset),
+    )
+    for eid in dict.fromkeys(e.trace.episode_id for e in entries):
+        ep = store.episode(eid)
+        if ep is not None:
+            run.episodes[eid] = ep
     from rover.report.judgements import load_judgements
 
     load_judgements(run)
     return run
 
 
-def _load_traces(run_dir: Path) -> list[TraceEntry]:
-    traces: list[TraceEntry] = []
-    for path in sorted(run_dir.rglob("*.json")):
-        if path.relative_to(run_dir).parts[0] in ("report", "judgements", "qa", "errors"):
-            continue
-        try:
-            raw = json.loads(path.read_text())
-        except (json.JSONDecodeError, UnicodeDecodeError, OSError):
-            continue
-        if not (isinstance(raw, dict) and "method" in raw and "frames" in raw):
-            continue
-        try:
-            traces.append(TraceEntry(Trace.model_validate(raw), path.stem, path))
-        except ValidationError as exc:
-            log.warning("skipping %s: not a valid trace (%s)", path, exc.errors()[0]["msg"])
-    return traces
-
-
-def _load_config(run_dir: Path) -> dict[str, Any]:
-    path = run_dir / RUN_CONFIG
-    if not path.exists():
-        return {}
-    try:
-        raw = json.loads(path.read_text())
-    except json.JSONDecodeError:
-        log.warning("skipping %s: not valid JSON", path)
-        return {}
-    return raw if isinstance(raw, dict) else {}
-
-
-def _load_aggregates(path: Path) -> list[dict[str, Any]]:
-    if not path.exists():
-        return []
-    try:
-        rows = json.loads(path.read_text()).get("aggregates", [])
-    except (json.JSONDecodeError, AttributeError, OSError):
-        log.warning("skipping %s: not readable as metrics", path)
-        return []
-    return [r for r in rows if isinstance(r, dict)]
-
-
-def _dataset_from_config(run_dir: Path, config: dict[str, Any]) -> Path | None:
-    """The dataset a run was made from: run.json's `dataset` (absolute or run-relative)."""
+def _dataset(run_dir: Path, config: dict[str, Any], given: Path | None) -> Path | None:
+    if given is not None:
+        if not (Path(given) / DATASET_FILE).exists():
+            raise InputError(f"{given}: not a rover dataset directory (no {DATASET_FILE})")
+        return Path(given)
     c = config.get("dataset")
     if isinstance(c, str) and c:
         for base in (Path(c), run_dir / c):
             if (base / DATASET_FILE).exists():
                 return base
-    if (run_dir / "dataset" / DATASET_FILE).exists():
-        return run_dir / "dataset"
     return None

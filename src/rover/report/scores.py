@@ -1,9 +1,8 @@
-"""Per-episode scores for every trace, and their means with standard errors.
+"""Per-video scores for the figures, read from metrics.json's per-trace rows.
 
-Task 1 numbers come from `rover.eval.progress_metrics` (the same functions `rover eval`
-uses, so the page agrees with `metrics.json`): predictions and truth on 0..100, aligned by
-original frame index. Task 2 and 3 numbers are computed from the run's judgement and QA
-files; token and call counts from the trace itself.
+Nothing is scored here: each `EpisodeScore` is one `per_trace` row of the run's
+metrics.json (written by `rover.eval.results.compute_metrics`, the one scorer), renamed
+for drawing. Rates are percentages, as everywhere in rover.
 """
 
 from __future__ import annotations
@@ -12,8 +11,6 @@ import math
 from dataclasses import dataclass, field
 
 from rover.eval.aggregate import mean_se as _eval_mean_se
-from rover.eval.progress_metrics import score_progress
-from rover.eval.stratify import nonexpert_share
 from rover.report.run import RunData, TraceEntry
 
 
@@ -22,8 +19,8 @@ class EpisodeScore:
     """Every number the report shows about one trace (one configuration on one episode)."""
 
     variant: str  # display label of the configuration
-    variant_id: str  # the run's variant id (file stem of the trace)
-    series: str  # the label without frame count / view
+    variant_id: str
+    series: str  # the label without frame count
     method: str
     episode_id: str
     task: str
@@ -34,13 +31,16 @@ class EpisodeScore:
     window: int | None
     tokens: int
     calls: int
+    dataset: str | None = None
+    setting_view: str | None = None  # the variant's view setting (None: each video's own)
+    setting_frames: int | None = None  # the variant's frame-count setting (None: all)
     pearson: float | None = None
     l2: float | None = None
     voc: float | None = None
     frame_corr: float | None = None
     non_expert_share: float | None = None
     error_rate: float | None = None  # % of judged frames with a verifiably false statement
-    success_rate: float | None = None  # % of frames true and not false
+    success_rate: float | None = None
     qa_accuracy: float | None = None
     qa_precision: float | None = None
     qa_recall: float | None = None
@@ -48,60 +48,41 @@ class EpisodeScore:
 
 
 def score_run(run: RunData) -> list[EpisodeScore]:
-    """Score every trace of the run, in the paper's method order."""
-    return [score_entry(run, e) for e in run.entries]
+    """The per-video rows of every drawn trace, in the paper's method order."""
+    return [score_entry(e) for e in run.entries]
 
 
-def score_entry(run: RunData, entry: TraceEntry) -> EpisodeScore:
-    trace = entry.trace
-    episode = run.episodes.get(trace.episode_id)
-    totals = trace.compute_totals() if trace.calls else trace.totals
-    window = trace.params.get("window")
-    row = EpisodeScore(
+def score_entry(entry: TraceEntry) -> EpisodeScore:
+    r = entry.row
+    return EpisodeScore(
         variant=entry.label,
         variant_id=entry.variant_id,
         series=entry.series,
-        method=trace.method,
-        episode_id=trace.episode_id,
-        task=trace.task,
-        task_group=(episode.task_group if episode else None) or "all",
-        level=episode.truth.level if episode and episode.truth else None,
-        num_frames=trace.num_frames,
-        view=trace.view,
-        window=window if isinstance(window, int) else None,
-        tokens=totals.total_tokens,
-        calls=totals.calls,
+        method=r["method"],
+        episode_id=r["episode_id"],
+        task=r.get("task") or entry.trace.task,
+        task_group=r.get("task_group") or "all",
+        level=r.get("level"),
+        num_frames=int(r.get("n_frames") or entry.trace.num_frames),
+        view=entry.view or None,
+        window=r.get("window"),
+        tokens=int(r.get("total_tokens") or 0),
+        calls=int(r.get("calls") or 0),
+        dataset=r.get("dataset"),
+        setting_view=entry.setting_view,
+        setting_frames=entry.setting_frames,
+        pearson=_finite(r.get("pearson")),
+        l2=_finite(r.get("l2")),
+        voc=_finite(r.get("voc")),
+        frame_corr=_finite(r.get("frame_corr")),
+        non_expert_share=_finite(r.get("nonexpert_share")),
+        error_rate=_finite(r.get("error_rate")),
+        success_rate=_finite(r.get("success_rate")),
+        qa_accuracy=_finite(r.get("qa_accuracy")),
+        qa_precision=_finite(r.get("qa_precision")),
+        qa_recall=_finite(r.get("qa_recall")),
+        qa_time_diffs=list(r.get("qa_dts") or []),
     )
-    if episode is not None and episode.truth is not None:
-        s = score_progress(trace, episode)
-        row.pearson, row.l2 = _finite(s.pearson), _finite(s.l2)
-        row.voc, row.frame_corr = _finite(s.voc), _finite(s.frame_corr)
-        row.non_expert_share = nonexpert_share(episode)
-    _judged_metrics(row, run, entry)
-    return row
-
-
-def _judged_metrics(row: EpisodeScore, run: RunData, entry: TraceEntry) -> None:
-    verdicts = run.verdicts.get(entry.key)
-    if verdicts:
-        vals = [v.verdict for v in verdicts.values()]
-        row.error_rate = 100.0 * sum(v == "false" for v in vals) / len(vals)
-        row.success_rate = 100.0 * sum(v == "true" for v in vals) / len(vals)
-    answers = [a for a in run.qa.get(entry.key, []) if a.predicted is not None]
-    if not answers:
-        return
-    row.qa_accuracy = 100.0 * sum(bool(a.predicted) == a.truth for a in answers) / len(answers)
-    said_yes = [a for a in answers if a.predicted]
-    if said_yes:
-        row.qa_precision = 100.0 * sum(a.truth for a in said_yes) / len(said_yes)
-    happened = [a for a in answers if a.truth]
-    if happened:
-        row.qa_recall = 100.0 * sum(bool(a.predicted) for a in happened) / len(happened)
-    row.qa_time_diffs = [
-        a.predicted_frame - a.truth_frame
-        for a in answers
-        if a.truth and a.predicted and a.truth_frame is not None and a.predicted_frame is not None
-    ]
 
 
 def mean_se(values: list[float | None]) -> tuple[float, float, int]:

@@ -1,22 +1,23 @@
 """The per-episode viewer: filmstrip, progress curves, reasoning tree, judged descriptions.
 
-Produces plain data for the page template (which escapes every string it prints) plus
-two kinds of markup built here: JPEG thumbnails written next to the page, and the
-progress chart as inline SVG, whose only text (axis labels) is escaped on the way in.
+Each episode is its own small page, `episodes/<episode>.html`, beside the main page,
+which lists every episode with its scores and shows one at a time in a frame: the main
+page stays small however many episodes a run has, and it all works from `file://`
+(no fetch, no server). Produces plain data for the templates (which escape every
+string they print) plus the progress chart as inline SVG, built here from numbers, whose
+only text (axis labels, tick numbers) is escaped on the way in.
 """
 
 from __future__ import annotations
 
 import html
+import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from PIL import Image
-
 from rover.methods.trace import LineNode
 from rover.report.run import RunData, TraceEntry
-
-THUMB_SIDE = 112
+from rover.report.scores import EpisodeScore
 
 
 @dataclass
@@ -37,7 +38,7 @@ class TreeNode:
     outcome: str
     final_description: str
     children: list[TreeNode] = field(default_factory=list)
-    plan: list[str] = field(default_factory=list)  # subtasks the model announced, if any
+    plan: list[str] = field(default_factory=list)
     calls: int = 0
 
 
@@ -46,65 +47,84 @@ class MethodView:
     variant: str
     method: str
     color: str
-    oracle: bool
+    view: str
     backend: str
     tokens: int
     calls: int
     rows: list[DescriptionRow]
     tree: TreeNode | None
     judged: bool
+    score: EpisodeScore | None = None
 
 
 @dataclass
 class EpisodeView:
     id: str
+    slug: str  # file stem of its page, episodes/<slug>.html
     task: str
     task_group: str
     level: int | None
+    dataset: str | None
     num_frames: int
-    thumbs: list[tuple[int, str]]  # (original frame index, relative path)
+    truth_kind: str  # "simulation", "frame_number", ... or "" without truth
+    thumbs: list[tuple[int, str]]  # (original frame index, path relative to the episode page)
     chart_svg: str  # trusted markup built by `progress_chart_svg`
     methods: list[MethodView]
+    spread: float | None = None  # how much the methods disagree (Pearson max - min)
     note: str = ""
 
 
 def build_episode_views(
-    run: RunData, out: Path, colors: dict[str, str], max_episodes: int = 40
+    run: RunData, out: Path, colors: dict[str, str], scores: list[EpisodeScore]
 ) -> list[EpisodeView]:
-    """One view per episode (at most `max_episodes`), thumbnails written under `out`."""
+    """One view per episode, frames copied under `out/frames`; most informative first."""
     by_episode: dict[str, list[TraceEntry]] = {}
     for e in run.entries:
         by_episode.setdefault(e.trace.episode_id, []).append(e)
-    return [
-        _episode_view(run, eid, by_episode[eid], out, colors)
-        for eid in sorted(by_episode)[:max_episodes]
-    ]
+    score_of = {(s.variant_id, s.episode_id): s for s in scores}
+    views = [_episode_view(run, eid, es, out, colors, score_of) for eid, es in by_episode.items()]
+    return sorted(views, key=lambda v: (-(v.spread if v.spread is not None else -1.0), v.id))
+
+
+def _spread(values: list[float | None]) -> float | None:
+    vals = [v for v in values if v is not None]
+    return max(vals) - min(vals) if len(vals) > 1 else None
 
 
 def _episode_view(
-    run: RunData, eid: str, entries: list[TraceEntry], out: Path, colors: dict[str, str]
+    run: RunData,
+    eid: str,
+    entries: list[TraceEntry],
+    out: Path,
+    colors: dict[str, str],
+    score_of: dict[tuple[str, str], EpisodeScore],
 ) -> EpisodeView:
     episode = run.episodes.get(eid)
     traces = [e.trace for e in entries]
+    slug = _safe(eid)
     indices = sorted({f.index for t in traces for f in t.frames})
-    thumbs: list[tuple[int, str]] = []
-    note = ""
-    with_frames = run.episode_frames(eid, traces[0].view)
-    if with_frames is not None:
-        thumbs = _write_thumbs(with_frames.frames(), with_frames.frame_indices, indices, out, eid)
-    else:
-        note = "frames unavailable (dataset not found)"
+    saved = run.thumbs(eid, entries[0].view or traces[0].view)
+    thumbs = []
+    if saved:
+        folder = out / "frames" / slug
+        folder.mkdir(parents=True, exist_ok=True)
+        for ix in indices or sorted(saved):
+            if ix in saved:
+                dest = folder / saved[ix].name
+                if not dest.exists():
+                    shutil.copyfile(saved[ix], dest)
+                thumbs.append((ix, f"../frames/{slug}/{dest.name}"))
+    note = "" if thumbs else "frames unavailable: this run kept no frames for the episode"
     truth: list[tuple[int, float]] = []
     if episode is not None and episode.truth is not None:
         truth = [
             (ix, p * 100)
             for ix, p in zip(episode.frame_indices, episode.truth.progress, strict=True)
         ]
-    methods = []
-    curves = []
+    methods, curves = [], []
     for entry in entries:
-        t, variant = entry.trace, entry.label
-        color = colors.get(variant, "#555555")
+        t = entry.trace
+        color = colors.get(entry.label, "#555555")
         verdicts = run.verdicts.get(entry.key, {})
         rows = [
             DescriptionRow(
@@ -118,31 +138,36 @@ def _episode_view(
             )
             for f in t.frames
         ]
-        totals = t.totals if t.totals.calls or not t.calls else t.compute_totals()
+        score = score_of.get(entry.key)
         methods.append(
             MethodView(
-                variant=variant,
+                variant=entry.label,
                 method=t.method,
                 color=color,
-                oracle=t.oracle or t.backend == "oracle",
+                view=entry.view,
                 backend=f"{t.backend}:{t.model}" if t.model else t.backend,
-                tokens=totals.total_tokens,
-                calls=totals.calls,
+                tokens=score.tokens if score else t.totals.total_tokens,
+                calls=score.calls if score else t.totals.calls,
                 rows=rows,
                 tree=_tree(t.tree) if t.tree is not None else None,
                 judged=bool(verdicts),
+                score=score,
             )
         )
-        curves.append((variant, color, [(f.index, f.progress or 0.0) for f in t.frames]))
+        curves.append((entry.label, color, [(f.index, f.progress or 0.0) for f in t.frames]))
     return EpisodeView(
         id=eid,
+        slug=slug,
         task=episode.task if episode else traces[0].task,
         task_group=(episode.task_group if episode else None) or "",
         level=episode.truth.level if episode and episode.truth else None,
+        dataset=entries[0].row.get("dataset"),
         num_frames=len(indices),
+        truth_kind=episode.truth.progress_source if episode and episode.truth else "",
         thumbs=thumbs,
         chart_svg=progress_chart_svg(truth, curves),
         methods=methods,
+        spread=_spread([m.score.pearson if m.score else None for m in methods]),
         note=note,
     )
 
@@ -160,25 +185,6 @@ def _tree(node: LineNode) -> TreeNode:
     )
 
 
-def _write_thumbs(
-    frames, frame_indices: list[int], wanted: list[int], out: Path, eid: str
-) -> list[tuple[int, str]]:
-    folder = out / "frames" / _safe(eid)
-    folder.mkdir(parents=True, exist_ok=True)
-    pos_of = {ix: p for p, ix in enumerate(frame_indices)}
-    thumbs = []
-    for ix in wanted or frame_indices:
-        if ix not in pos_of:
-            continue
-        path = folder / f"{ix:05d}.jpg"
-        if not path.exists():
-            img = Image.fromarray(frames[pos_of[ix]])
-            img.thumbnail((THUMB_SIDE, THUMB_SIDE))
-            img.save(path, format="JPEG", quality=80)
-        thumbs.append((ix, path.relative_to(out).as_posix()))
-    return thumbs
-
-
 def _safe(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "episode"
 
@@ -187,10 +193,13 @@ def progress_chart_svg(
     truth: list[tuple[int, float]],
     curves: list[tuple[str, str, list[tuple[int, float]]]],
     width: int = 640,
-    height: int = 240,
+    height: int = 260,
 ) -> str:
-    """Ground truth (dashed black) against each method's progress, as inline SVG markup."""
-    left, right, top, bottom = 40, 10, 10, 28
+    """Ground truth (dashed black) against each method's progress, as inline SVG markup.
+
+    Curve i carries class `curve-i`, so the page's legend checkboxes can hide it (CSS only).
+    """
+    left, right, top, bottom = 52, 10, 10, 44
     xs = [x for x, _ in truth] + [x for _, _, pts in curves for x, _ in pts]
     x0, x1 = (min(xs), max(xs)) if xs else (0, 1)
     x1 = x1 if x1 > x0 else x0 + 1
@@ -217,23 +226,35 @@ def progress_chart_svg(
         )
     for x in _ticks(x0, x1):
         parts.append(
-            f'<text x="{sx(x):.1f}" y="{height - 10}" text-anchor="middle" '
+            f'<text x="{sx(x):.1f}" y="{top + ph + 16}" text-anchor="middle" '
             f'font-size="11" fill="#555">{x}</text>'
         )
-    for name, color, pts in reversed(curves):  # the first method (ROVER) drawn on top
-        parts.append(_polyline(pts, sx, sy, html.escape(color, quote=True), 1.8, "", name))
+    parts.append(
+        f'<text x="{left + pw / 2:.1f}" y="{height - 6}" text-anchor="middle" font-size="12" '
+        f'fill="#333">frame index (original video)</text>'
+    )
+    parts.append(
+        f'<text x="14" y="{top + ph / 2:.1f}" text-anchor="middle" font-size="12" fill="#333" '
+        f'transform="rotate(-90 14 {top + ph / 2:.1f})">task progress (%)</text>'
+    )
+    for i, (name, color, pts) in reversed(list(enumerate(curves))):  # first drawn on top
+        parts.append(
+            _polyline(pts, sx, sy, html.escape(color, quote=True), 1.8, "", name, f"curve-{i}")
+        )
     if truth:
         parts.append(
-            _polyline(truth, sx, sy, "#000", 2.6, ' stroke-dasharray="6 4"', "ground truth")
+            _polyline(
+                truth, sx, sy, "#000", 2.6, ' stroke-dasharray="6 4"', "ground truth", "truth"
+            )
         )
     parts.append("</svg>")
     return "".join(parts)
 
 
-def _polyline(pts, sx, sy, color: str, width: float, extra: str, name: str) -> str:
+def _polyline(pts, sx, sy, color: str, width: float, extra: str, name: str, cls: str) -> str:
     coords = " ".join(f"{sx(x):.1f},{sy(y):.1f}" for x, y in pts)
     return (
-        f'<polyline fill="none" stroke="{color}" stroke-width="{width}"{extra} '
+        f'<polyline class="{cls}" fill="none" stroke="{color}" stroke-width="{width}"{extra} '
         f'points="{coords}"><title>{html.escape(name)}</title></polyline>'
     )
 
