@@ -31,7 +31,11 @@ def safe(text: Any) -> str:
 
 
 def esc(text: Any) -> str:
-    """`safe(text)` escaped for use inside a Rich markup string."""
+    """`safe(text)` escaped for use inside a Rich markup string.
+
+    As with Rich's own `escape`, a trailing backslash is doubled so that a tag after it
+    still closes; at the very end of a line it shows as two.
+    """
     return escape(safe(text))
 
 
