@@ -127,6 +127,7 @@ def test_judge_cards_name_the_judge_and_its_measured_agreement() -> None:
     assert rule is not None and rule.agreement == m["rule_judge"]["agreement"]
     assert "rule judge" in rule.line() and f"{100 * rule.agreement:.1f}%" in rule.line()
     assert rule.fresh_n > 0 and "fresh words" in rule.line()
+    assert str(rule) == rule.short() and rule.short() in rule.line()
     answerer = judge_card("answerer", "rule")
     assert answerer is not None and answerer.n == m["rule_answerer"]["n"]
     llm = judge_card("judge", "gemini:gemini-2.5-flash")

@@ -50,6 +50,18 @@ class JudgeCard:
     fresh_agreement: float | None = None
     fresh_n: int = 0
 
+    def short(self) -> str:
+        """The agreement alone, for a table cell or after the judge's name."""
+        if self.agreement is None:
+            return "not measured"
+        out = f"{100 * self.agreement:.1f}% on {self.n} held-out cases"
+        if self.fresh_agreement is not None:
+            out += f" ({100 * self.fresh_agreement:.1f}% on the {self.fresh_n} in fresh words)"
+        return out
+
+    def __str__(self) -> str:
+        return self.short()
+
     def line(self) -> str:
         """One line for summaries: name and agreement (or why there is none)."""
         what = "Task 2 judge" if self.kind == "judge" else "Task 3 QA answerer"
@@ -81,7 +93,7 @@ def judge_card(kind: str, spec: str = "rule") -> JudgeCard | None:
     """The card for the Task 2 judge (`kind="judge"`) or Task 3 answerer ("answerer").
 
     `spec` is what `--judge` / `--answerer` was given; None comes back when that stage
-    was switched off ('none').
+    was switched off ('none'). Use: `judge_card("judge", run["judge"]).line()`.
     """
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
