@@ -67,11 +67,9 @@ class JudgeCard:
         what = "Task 2 judge" if self.kind == "judge" else "Task 3 QA answerer"
         if self.agreement is None:
             return f"{what}: {self.name} — agreement not measured. {self.note}".strip()
-        agree = f"{100 * self.agreement:.1f}% agreement with labels on {self.n} held-out cases"
-        if self.fresh_agreement is not None:
-            agree += f" ({100 * self.fresh_agreement:.1f}% on the {self.fresh_n} in fresh words)"
         tail = f"; {self.note}" if self.note else ""
-        return f"{what}: {self.name} — {agree}, corpus v{self.corpus}{tail}"
+        agree = f"agreement with the labels {self.short()}, corpus v{self.corpus}"
+        return f"{what}: {self.name} — {agree}{tail}"
 
 
 @cache
