@@ -44,9 +44,10 @@ def test_budget_rule():
     assert budget_for(OracleBackend()).fixed is None
 
 
-async def test_gvl_on_30_frames_gets_the_budget_it_needs(make_episode):
+@pytest.mark.parametrize("method", ["gvl", "gvl-single", "video-concat"])
+async def test_30_frames_get_the_budget_they_need(make_episode, method):
     vlm = Recording(OracleBackend())
-    trace = await get_method("gvl").run(make_episode(30), vlm)
+    trace = await get_method(method).run(make_episode(30), vlm)
     assert max(p.max_tokens for p in vlm.params) >= 1200
     assert trace.totals.truncated_replies == 0 and trace.totals.parse_failures == 0
     assert all(f.predicted for f in trace.frames[1:])  # no frame lost

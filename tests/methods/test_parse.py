@@ -139,3 +139,35 @@ def test_fuzz_never_raises():
             assert ans.progress is None or math.isfinite(ans.progress)
         a = parse_frame(reply)
         assert a.progress is None or math.isfinite(a.progress)
+
+
+def test_only_the_first_64_kb_and_2000_lines_are_read():
+    from rover.methods.parse import MAX_PARSE_CHARS, reply_capped
+
+    head = "Frame description: ok\nSubtask completion percentage: 45%\n"
+    late = "x" * MAX_PARSE_CHARS + "\nThe robot needs to: grasp the can"
+    r = parse_step(head + late)
+    assert r.progress == 45 and r.new_subtask is None  # the late marker is never read
+    assert reply_capped(head + late) and not reply_capped(head)
+    many = "\n" * 2000 + "Subtask completion percentage: 10%"  # line 2,001
+    assert parse_step(many).progress is None and reply_capped(many)
+    assert parse_step("\n" * 1990 + "Subtask completion percentage: 10%").progress == 10
+
+
+def test_the_trace_says_when_a_reply_was_capped():
+    from rover.methods.base import Session
+    from rover.vlm.types import Completion, Prompt, PromptMeta, SamplingParams
+
+    class Stub:
+        trace = type("T", (), {"calls": []})()
+
+    long = "Frame description: x\nSubtask completion percentage: 5%\n" + "y" * 70_000
+    rec = Session._record(
+        Stub(),  # type: ignore[arg-type]
+        Prompt(messages=[], meta=PromptMeta(kind="rover.step")),
+        Completion(text=long),
+        "ok",
+        None,
+        SamplingParams(max_tokens=100_000),
+    )
+    assert rec.reply_capped and not rec.truncated
