@@ -2,6 +2,13 @@
 
 Usage: python benchmarks/generate_speed.py [--tasks Lift,PickPlaceCan] [--episodes 4]
        [--frames 30] [--views left,wrist] [--size 128]
+       python benchmarks/generate_speed.py --full [--tasks all] [--per-level 3] [--workers 2]
+       [--views left,wrist] [--size 256]
+
+``--full`` times one whole `rover generate` run (every level, ``--per-level`` videos each,
+``--workers`` processes, expert demos included), prints the load average before and after
+(the machine may be shared: compare runs made under similar load), and lists how many
+tries each level needed to meet its milestone (read from the written ``dataset.json``).
 
 Per task, after a warm-up episode (the first episode per process pays for building the
 env, the renderer and numba/EGL start-up): the full pipeline (perturb + value + facts +
@@ -13,6 +20,8 @@ seconds include every thread of the process (llvmpipe renders with several).
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -31,14 +40,74 @@ def _timed(fn) -> tuple[float, float]:
     return time.perf_counter() - w, time.process_time() - c
 
 
+def _load() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def full_run(args: argparse.Namespace) -> None:
+    """Time one whole generation run and report the tries each level took."""
+    from rover.sim.generate import generate
+    from rover.sim.tasks import task_names
+
+    tasks = task_names() if args.tasks == "all" else args.tasks.split(",")
+    cfg = GenerateConfig(
+        tasks=tasks,
+        per_level=args.per_level,
+        views=args.views.split(","),
+        size=args.size if args.size else 256,
+        seed=args.seed,
+    )
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(args.keep) if args.keep else Path(tmp) / "ds"
+        before = _load()
+        start = time.perf_counter()
+        ids = generate(cfg, out, workers=args.workers)
+        wall = time.perf_counter() - start
+        after = _load()
+        info = json.loads((out / "dataset.json").read_text())
+    console = Console(width=150)
+    console.print(
+        f"full run: {len(tasks)} tasks, {len(ids)} episodes, per-level {args.per_level}, "
+        f"{args.workers} workers, views {args.views}, {cfg.size} px: {wall:.1f} s wall "
+        f"(load average 1/5/15 min before: {before}; after: {after})"
+    )
+    tries = info.get("generator", {}).get("tries", {})
+    if not tries:
+        console.print("(this version records no tries per level)")
+        return
+    table = Table(title="tries per episode to meet the level's milestone (mean / max)")
+    table.add_column("task")
+    top = max(len(v) for v in tries.values())
+    for lv in range(1, top + 1):
+        table.add_column(f"L{lv}", justify="right")
+    for task, per in tries.items():
+        cells = []
+        for lv in range(1, top + 1):
+            got = per.get(str(lv))
+            cells.append("" if not got else f"{sum(got) / len(got):.1f} / {max(got)}")
+        table.add_row(task, *cells)
+    console.print(table)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--tasks", default="Lift,PickPlaceCan")
+    ap.add_argument("--tasks", default=None, help="comma-separated, or 'all' (--full default)")
     ap.add_argument("--episodes", type=int, default=4)
     ap.add_argument("--frames", type=int, default=30)
     ap.add_argument("--views", default="left,wrist")
-    ap.add_argument("--size", type=int, default=128)
+    ap.add_argument("--size", type=int, default=0, help="px (default 128; --full: 256)")
+    ap.add_argument("--full", action="store_true", help="time one whole generate run")
+    ap.add_argument("--per-level", type=int, default=3)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--keep", default=None, help="--full: write the dataset here (kept)")
     args = ap.parse_args()
+    if args.full:
+        args.tasks = args.tasks or "all"
+        full_run(args)
+        return
+    args.tasks = args.tasks or "Lift,PickPlaceCan"
+    args.size = args.size or 128
     views = args.views.split(",")
     table = Table(
         title=f"rover generate: {args.frames} frames x {len(views)} views, "

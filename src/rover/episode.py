@@ -67,6 +67,8 @@ class ObjectFacts(BaseModel):
     lifted: bool = False
     inside: str | None = None  # the receptacle/region it is in ("bin 2", "drawer")
     on: str | None = None  # the surface/object it rests on
+    reach: float | None = None  # m from the gripper to the point it is taken by (handle)
+    goal_distance: float | None = None  # m (table plane) from the object to its goal point
 
 
 class FrameFacts(BaseModel):
@@ -82,6 +84,8 @@ class FrameFacts(BaseModel):
     articulations: dict[str, float] = Field(default_factory=dict)
     pressed: list[str] = Field(default_factory=list)
     distances: dict[str, float] = Field(default_factory=dict)  # e.g. "gripper-can": 0.12 m
+    eef: tuple[float, float, float] | None = None  # gripper (end effector) position, m
+    robot_contacts: list[str] = Field(default_factory=list)  # objects any robot part touches
 
 
 class GroundTruth(BaseModel):

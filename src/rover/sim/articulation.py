@@ -101,13 +101,8 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
         return Event(name=event, object=name, frame=frame)
 
     signals = {s.end_signal.partition(":")[0] for s in spec.subtasks}
-    # a grasp, as for free objects: held, or touched with the gripper closed
-    grasp = ev(
-        "grasp",
-        _first(
-            facts, lambda f: f.holding == name or (name in f.contacts and f.gripper == "closed")
-        ),
-    )
+    # a grasp, as for free objects: a hold begins (both fingers on it, moving with the hand)
+    grasp = ev("grasp", _first(facts, lambda f: f.holding == name))
     if name == "drawer" and "drawer_closed" in signals:
         return [
             grasp,

@@ -92,6 +92,8 @@ class SimEnv:
         fj = [self.model.joint(j) for j in self._gripper.joints]
         self._finger_qpos = [int(j.qposadr[0]) for j in fj]
         self._geom_owner = self._object_geoms()
+        self._robot_geoms = self._subtree_geoms(self._robot.robot_model.root_body)
+        self.robot_qpos, self.robot_qvel = self._subtree_dofs(self._robot.robot_model.root_body)
         self.start_positions: dict[str, np.ndarray] = {}
 
     # ----------------------------------------------------------------- set-up
@@ -117,6 +119,36 @@ class SimEnv:
                 if b == root:
                     owner[g] = obj.name
         return owner
+
+    def _in_subtree(self, body: int, root: int) -> bool:
+        parents = self.model.body_parentid
+        while body != 0 and body != root:
+            body = int(parents[body])
+        return body == root
+
+    def _subtree_geoms(self, root_name: str) -> set[int]:
+        root = self._body_id(root_name)
+        return {
+            g
+            for g in range(self.model.ngeom)
+            if self._in_subtree(int(self.model.geom_bodyid[g]), root)
+        }
+
+    def _subtree_dofs(self, root_name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Flat-state indices (after the time entry) of the qpos and qvel of a subtree's joints:
+        the robot's arm and fingers, which a recovery may interpolate."""
+        root = self._body_id(root_name)
+        qpos: list[int] = []
+        qvel: list[int] = []
+        sizes = {0: (7, 6), 1: (4, 3), 2: (1, 1), 3: (1, 1)}  # free, ball, slide, hinge
+        for j in range(self.model.njnt):
+            if not self._in_subtree(int(self.model.jnt_bodyid[j]), root):
+                continue
+            nq, nv = sizes[int(self.model.jnt_type[j])]
+            qa, va = int(self.model.jnt_qposadr[j]), int(self.model.jnt_dofadr[j])
+            qpos += range(qa, qa + nq)
+            qvel += range(va, va + nv)
+        return np.asarray(qpos, dtype=np.int64), np.asarray(qvel, dtype=np.int64)
 
     def reset(self, seed: int) -> np.ndarray:
         """Reset to the initial configuration drawn from `seed`; return the flat state."""
@@ -162,6 +194,27 @@ class SimEnv:
     def interpolate(self, a: np.ndarray, b: np.ndarray, alpha: float) -> np.ndarray:
         return interpolate_state(self.model, a, b, alpha)
 
+    def drive_robot(self, a: np.ndarray, b: np.ndarray, alpha0: float, alpha1: float) -> None:
+        """One recovery step with physics: the robot's joints follow the interpolation
+        from state `a` to state `b` (fraction alpha0 -> alpha1) over one control step,
+        and everything else (free objects, doors, drawers) is simulated, so an object moves
+        only if the robot pushes or carries it, or gravity does. Starts from the current
+        state; no object is ever set to a pose physics did not reach."""
+        qa = a[1 + self.robot_qpos]
+        qb = b[1 + self.robot_qpos]
+        substeps = max(1, int(round(self.env.control_timestep / self.model.opt.timestep)))
+        dt = self.env.control_timestep
+        vel = (qb - qa) * (alpha1 - alpha0) / dt
+        d = self.data
+        for k in range(1, substeps + 1):
+            t = alpha0 + (alpha1 - alpha0) * k / substeps
+            d.qpos[self.robot_qpos] = (1.0 - t) * qa + t * qb
+            d.qvel[self.robot_qvel] = vel
+            mujoco.mj_step(self.model, d)
+        d.qpos[self.robot_qpos] = (1.0 - alpha1) * qa + alpha1 * qb
+        d.qvel[self.robot_qvel] = vel
+        self.sim.forward()
+
     def entity_positions(self) -> np.ndarray:
         pts = [self.point("eef")] + [self.point(o.name) for o in self.spec.objects]
         return np.stack(pts)
@@ -174,6 +227,8 @@ class SimEnv:
             return d.geom_xpos[self._pad_geoms[name.split("_")[0]]].copy()
         if name.startswith("goal:"):
             return self.goal(name[5:])
+        if name.startswith("joint:"):  # a scalar carried in x: fraction of the way to the goal
+            return np.array([self.joint_fraction(name[6:]), 0.0, 0.0])
         obj_name, _, site = name.partition(":")
         obj = self.spec.object_spec(obj_name)
         if site:
@@ -246,6 +301,23 @@ class SimEnv:
                     out.setdefault(self._geom_owner[b], set()).add(fingers[a])
         return out
 
+    def robot_contacts(self) -> set[str]:
+        """Objects any part of the robot (arm, hand or fingers) touches now."""
+        out: set[str] = set()
+        for i in range(self.data.ncon):
+            g1, g2 = int(self.data.contact[i].geom1), int(self.data.contact[i].geom2)
+            for a, b in ((g1, g2), (g2, g1)):
+                if a in self._robot_geoms and b in self._geom_owner:
+                    out.add(self._geom_owner[b])
+        return out
+
+    def eef_frame(self) -> tuple[np.ndarray, np.ndarray]:
+        """The end effector's position and rotation matrix (world frame)."""
+        return (
+            self.data.site_xpos[self._eef_site].copy(),
+            self.data.site_xmat[self._eef_site].reshape(3, 3).copy(),
+        )
+
     def gripper_opening(self) -> float:
         """0 = fingers fully closed, 1 = fully open (Panda: 0.08 m between fingers)."""
         q = self.data.qpos
@@ -291,6 +363,36 @@ class SimEnv:
         if found is not None:
             return found
         raise ValueError(f"unknown end signal {signal!r}")
+
+    def joint_fraction(self, obj: str) -> float:
+        """How far an articulated object's joint has gone toward its goal, 0..1 (door
+        hinge, drawer slide, button travel, knob turn)."""
+        if obj == "door" and "door_open" in self.spec.goals:
+            return float(np.clip(self.hinge_angle() / self.spec.goals["door_open"].angle, 0, 1))
+        fx = articulation.fixture(self)
+        if fx is None:
+            raise ValueError(f"{self.spec.name}: {obj!r} has no joint")
+        return float(fx.progress())
+
+    def kept(self, signal: str) -> bool:
+        """Whether a subtask's achievement still stands in this state (for progress).
+
+        Looser than `predicate`, which marks the moment a subtask ends: a grasp stands
+        while any finger touches the object, a placement while the object lies in its
+        goal (touched or not); pressing a button or touching it cannot be undone.
+        """
+        kind, _, obj = signal.partition(":")
+        if kind in ("grasped", "lifted"):
+            return obj in self.finger_contacts()
+        if kind == "placed":
+            return self.in_bin(obj) == self.spec.bins[obj]
+        if kind == "stacked":
+            return self.on_top(obj, self.spec.goals["on"].object)
+        if kind == "on_peg":
+            return self.on_peg(obj)
+        if kind in ("pressed", "touched"):
+            return True
+        return self.predicate(signal)
 
     def on_top(self, obj: str, below: str) -> bool:
         p, q = self.point(obj), self.point(below)

@@ -4,6 +4,14 @@ Facts are read from MuJoCo for exactly the frames a video shows, and events are 
 from that same fact sequence (the first frame where the facts change in the named way),
 so facts and events can never disagree: an event's frame always shows it. QA items
 (App. C.3) are answered from the events: "yes, at frame t" or "no".
+
+Holding is physical, not a height test: the robot holds an object when both fingers
+touch it and it moves with the gripper (its position in the hand's frame is unchanged
+since the previous control step), at any height. A hold, once begun, survives a frame
+where one finger loses contact for a moment, as long as the object still moves with the
+hand. Events follow from holds: ``grasp`` is a hold beginning, ``pick_up`` a held object
+first lifted off its start, and a hold's end is a ``place`` when the object is then
+resting in or on its goal region and a ``drop`` otherwise (it falls).
 """
 
 from __future__ import annotations
@@ -18,38 +26,87 @@ from rover.sim.tasks.base import TaskSpec
 CLOSED_BELOW = 0.9  # opening fraction under which the gripper reads as closed
 OPEN_START = 0.05  # door opening fraction at which "start opening" happens
 OPEN_FINISH = 0.9  # ... and "completely open"
+MOVES_WITH = 0.005  # m: the most a held object may shift in the hand's frame per step
+FULLY_OPEN = 0.97  # opening fraction above which fingers touching both sides only brush it
 
 
-def frame_facts(sim: SimEnv) -> FrameFacts:
-    """Facts of the simulator's current state."""
+def grip_point(spec: TaskSpec, obj: str) -> str:
+    """The named point the hand takes an object by: its first subtask's contact point."""
+    for s in spec.subtasks:
+        if s.object == obj and s.object_points:
+            return s.object_points[0]
+    return obj
+
+
+def goal_point(spec: TaskSpec, obj: str) -> str | None:
+    """The goal point an object is carried to (the last subtask on it with a goal)."""
+    found = None
+    for s in spec.subtasks:
+        if s.object == obj and s.goal is not None:
+            found = s.goal
+    return found
+
+
+def hand_positions(sim: SimEnv) -> dict[str, np.ndarray]:
+    """Each object's grip point in the end effector's frame (for the moves-with test)."""
+    pos, rot = sim.eef_frame()
+    return {
+        o.name: rot.T @ (sim.point(grip_point(sim.spec, o.name)) - pos) for o in sim.spec.objects
+    }
+
+
+def frame_facts(
+    sim: SimEnv,
+    before: dict[str, np.ndarray] | None = None,
+    held_before: str | None = None,
+) -> FrameFacts:
+    """Facts of the simulator's current state.
+
+    Args:
+        sim: the simulator, posed at the state to describe.
+        before: `hand_positions` one control step earlier (None: the object is taken to
+            move with the hand, as at an episode's first frame).
+        held_before: the object held at the previous video frame (keeps a hold through
+            a one-frame loss of one finger's contact).
+    """
     spec = sim.spec
     touching = sim.finger_contacts()
+    robot_touch = sim.robot_contacts()
     opening = sim.gripper_opening()
+    now = hand_positions(sim)
     holding = None
     objects: dict[str, ObjectFacts] = {}
-    articulations: dict[str, float] = {}
     distances: dict[str, float] = {}
     eef = sim.point("eef")
     for obj in spec.objects:
-        pos = sim.point(obj.name)
-        both = touching.get(obj.name) == {"left", "right"}
-        lifted = obj.graspable and sim.lifted(obj.name)
-        if both and (lifted or not obj.graspable):
-            holding = obj.name
-        objects[obj.name] = ObjectFacts(
+        name = obj.name
+        pos = sim.point(name)
+        fingers = touching.get(name, set())
+        moves = before is None or float(np.linalg.norm(now[name] - before[name])) < MOVES_WITH
+        both = fingers == {"left", "right"} and opening < FULLY_OPEN
+        kept = held_before == name and bool(fingers)
+        if (both or kept) and moves and articulation.holdable(sim, name) and holding is None:
+            holding = name
+        goal = goal_point(spec, name)
+        goal_dist = None
+        if goal is not None and obj.graspable:
+            goal_dist = round(float(np.linalg.norm((pos - sim.point(goal))[:2])), 4)
+        lifted = obj.graspable and sim.lifted(name)
+        objects[name] = ObjectFacts(
             position=tuple(round(float(x), 4) for x in pos),
             lifted=bool(lifted),
-            inside=_inside(sim, obj.name),
-            on=_on(sim, obj.name, lifted, both),
+            inside=_inside(sim, name),
+            on=_on(sim, name, lifted, holding == name),
+            reach=round(float(np.linalg.norm(eef - sim.point(grip_point(spec, name)))), 4),
+            goal_distance=goal_dist,
         )
-        distances[f"gripper-{obj.name}"] = round(float(np.linalg.norm(eef - pos)), 4)
+        distances[f"gripper-{name}"] = round(float(np.linalg.norm(eef - pos)), 4)
+    articulations: dict[str, float] = {}
     if "door_open" in spec.goals:
         frac = sim.hinge_angle() / spec.goals["door_open"].angle
         articulations["door"] = round(float(np.clip(frac, 0.0, 1.0)), 3)
     fixture_parts, pressed = articulation.articulation_facts(sim)
     articulations.update(fixture_parts)
-    if holding is not None and not articulation.holdable(sim, holding):
-        holding = None  # a fingertip on a push button is not a hold
     return FrameFacts(
         gripper="closed" if opening < CLOSED_BELOW else "open",
         gripper_opening=round(opening, 3),
@@ -59,6 +116,8 @@ def frame_facts(sim: SimEnv) -> FrameFacts:
         articulations=articulations,
         pressed=pressed,
         distances=distances,
+        eef=tuple(round(float(x), 4) for x in eef),
+        robot_contacts=sorted(robot_touch),
     )
 
 
@@ -80,7 +139,7 @@ def _inside(sim: SimEnv, obj: str) -> str | None:
 
 def _on(sim: SimEnv, obj: str, lifted: bool, held: bool) -> str | None:
     spec = sim.spec
-    if not spec.object_spec(obj).graspable or lifted or held or _inside(sim, obj):
+    if not spec.object_spec(obj).graspable or held or _inside(sim, obj):
         return None
     for other in spec.objects:
         if other.name != obj and other.graspable and sim.on_top(obj, other.name):
@@ -91,12 +150,31 @@ def _on(sim: SimEnv, obj: str, lifted: bool, held: bool) -> str | None:
     return None
 
 
-def facts_for_states(sim: SimEnv, states: np.ndarray) -> list[FrameFacts]:
-    """Facts of each state in order (sets the simulator's state)."""
-    out = []
-    for s in states:
+def facts_for_states(
+    sim: SimEnv, states: np.ndarray, previous: np.ndarray | None = None
+) -> list[FrameFacts]:
+    """Facts of each state in order (sets the simulator's state).
+
+    Args:
+        sim: the simulator.
+        states: (N, S) the video's states.
+        previous: (N, S) the state one control step before each (None: the previous
+            video frame; pass the rollout's step t-1 so "moves with the hand" is judged
+            over one step, as physics would).
+    """
+    out: list[FrameFacts] = []
+    prev_hand: dict[str, np.ndarray] | None = None
+    held: str | None = None
+    for t, s in enumerate(states):
+        if previous is not None and t > 0:
+            sim.set_state(previous[t])
+            prev_hand = hand_positions(sim)
         sim.set_state(s)
-        out.append(frame_facts(sim))
+        f = frame_facts(sim, prev_hand, held)
+        out.append(f)
+        held = f.holding
+        if previous is None:
+            prev_hand = hand_positions(sim)
     return out
 
 
@@ -107,7 +185,7 @@ def _first(facts: list[FrameFacts], test, after: int = 0) -> int | None:
     return None
 
 
-def _target_reached(spec: TaskSpec, obj: str, f: FrameFacts) -> bool:
+def target_reached(spec: TaskSpec, obj: str, f: FrameFacts) -> bool:
     o = f.objects.get(obj)
     if o is None or f.holding == obj:
         return False
@@ -118,6 +196,35 @@ def _target_reached(spec: TaskSpec, obj: str, f: FrameFacts) -> bool:
     if "on" in spec.goals:
         return o.on == spec.goals["on"].object
     return False
+
+
+def hold_spans(facts: list[FrameFacts], obj: str) -> list[tuple[int, int | None]]:
+    """(first held frame, first frame after the hold or None) for each hold of `obj`."""
+    spans: list[tuple[int, int | None]] = []
+    start = None
+    for t, f in enumerate(facts):
+        if f.holding == obj and start is None:
+            start = t
+        elif f.holding != obj and start is not None:
+            spans.append((start, t))
+            start = None
+    if start is not None:
+        spans.append((start, None))
+    return spans
+
+
+def releases(spec: TaskSpec, facts: list[FrameFacts], obj: str) -> list[tuple[str, int]]:
+    """("place" | "drop", frame) for each hold of `obj` that ends, in order.
+
+    A hold ends at the first frame the object is not held; it is a place when the object
+    rests in or on its goal region there, else a drop.
+    """
+    out: list[tuple[str, int]] = []
+    for _, end in hold_spans(facts, obj):
+        if end is None:
+            continue
+        out.append(("place" if target_reached(spec, obj, facts[end]) else "drop", end))
+    return out
 
 
 def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
@@ -132,20 +239,14 @@ def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
         contact = _first(facts, lambda f, n=name: n in f.contacts)
         events.append(Event(name="contact", object=name, frame=contact))
         if obj.graspable:
-            grasp = _first(facts, lambda f, n=name: f.holding == n or _both(f, n))
+            spans = hold_spans(facts, name)
+            grasp = spans[0][0] if spans else None
             pick = _first(facts, lambda f, n=name: f.holding == n and f.objects[n].lifted)
             events.append(Event(name="grasp", object=name, frame=grasp))
             events.append(Event(name="pick_up", object=name, frame=pick))
-            drop = place = None
-            if pick is not None:
-                place = _first(facts, lambda f, n=name: _target_reached(spec, n, f), pick)
-                drop = _first(
-                    facts,
-                    lambda f, n=name: f.holding != n and not _target_reached(spec, n, f),
-                    pick,
-                )
-                if drop is not None and place is not None and drop > place:
-                    drop = None
+            ends = releases(spec, facts, name)
+            drop = next((t for kind, t in ends if kind == "drop"), None)
+            place = next((t for kind, t in ends if kind == "place"), None)
             events.append(Event(name="drop", object=name, frame=drop))
             if spec.bins or "on" in spec.goals or "peg" in spec.goals:
                 events.append(Event(name="place", object=name, frame=place))
@@ -170,11 +271,6 @@ def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
         elif name in articulation.PARTS:
             events += articulation.fixture_events(spec, name, facts)
     return events
-
-
-def _both(f: FrameFacts, name: str) -> bool:
-    # grasp = touched while the gripper is closed on it (holding also needs a lift)
-    return name in f.contacts and f.gripper == "closed"
 
 
 def qa_items(spec: TaskSpec, events: list[Event]) -> list[QAItem]:

@@ -17,17 +17,19 @@ import multiprocessing as mp
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel
 
-from rover.episode import Episode, GroundTruth, StateType, Subtask, even_positions
+from rover.episode import Episode, GroundTruth, StateType, Subtask
 from rover.errors import InputError
 from rover.io.dataset import DatasetInfo, episode_ids, write_dataset_info, write_episode
 from rover.sim.kitchen.scene import scene_record
-from rover.sim.levels import LevelSpec, level_schedule, plan_seed
+from rover.sim.levels import LevelSpec, level_schedule
 from rover.sim.tasks import get_task
 from rover.sim.tasks.base import TaskSpec
+from rover.sim.validate import validate_episode
 
 MAX_FRAMES = 240
 _log = logging.getLogger(__name__)
@@ -45,6 +47,8 @@ class GenerateConfig(BaseModel):
     seed: int = 0
     demos: int = 3  # expert demonstrations per task (source dataset size)
     source_hdf5: str | None = None
+    # "rover": progress with the documented departures from Sec. 4.2; "paper": as written
+    progress_form: Literal["rover", "paper"] = "rover"
 
 
 @dataclass
@@ -119,6 +123,7 @@ def _sim_for(spec: TaskSpec):
 
 def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskState:
     """This process's simulator, renderer and loaded demos for a task (built once)."""
+    from rover.sim.attempt import trim_demo
     from rover.sim.demos import read_demos
     from rover.sim.experts import subtask_ends
     from rover.sim.render import StateRenderer
@@ -144,7 +149,8 @@ def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskSta
                 f"{spec.name}: demonstration {rec.name} never completes subtask "
                 f"{spec.subtasks[len(ends)].name!r}; it cannot serve as an expert"
             )
-        demos.append((rec.states, rec.actions, list(ends), seed))
+        states, actions, ends = trim_demo(sim, rec.states, rec.actions, list(ends))
+        demos.append((states, actions, ends, seed))
     _CACHE[key] = _TaskState(sim, _RENDERERS[(spec.name, cfg.size)], demos)
     return _CACHE[key]
 
@@ -194,50 +200,48 @@ def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
 
 
 def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
-    """Generate and write one episode; returns its id."""
-    from rover.sim.facts import detect_events, facts_for_states, qa_items
-    from rover.sim.perturb import bounds_from_ends, execute_plan, plan_trajectory
-    from rover.sim.validate import validate_episode
-    from rover.sim.value import point_tracks, progress_from_tracks, required_points
+    """Generate and write one episode; returns its id.
+
+    Tries plans (new seed offset each time, at most `MAX_TRIES`) until one shows the
+    level's milestone and no object jumps; only that one is rendered. When none passes,
+    the try with the fewest problems is kept and its problems are recorded.
+    """
+    from rover.sim.attempt import make_attempts
+    from rover.sim.env import CONTROL_FREQ
+    from rover.sim.facts import qa_items
 
     spec = get_task(item.task)
     ts = _task_state(spec, cfg, out / "demos")
     sim = ts.sim
     level = next(lv for lv in spec.levels if lv.level == item.level)
-    rng = plan_seed(cfg.seed, item.task, item.index)
-    d = int(rng.integers(len(ts.demos)))
-    states, actions, ends, seed = ts.demos[d]
-    sim.reset(seed)  # places robosuite's visual-only markers as in the demo's scene
-    sim.begin(states[0])  # start positions (lift heights, goals) of this demo
-    bounds = bounds_from_ends(ends, len(states))
-    plan = plan_trajectory(len(states), bounds, level, rng)
-    roll = execute_plan(sim, states, actions, plan, np.random.default_rng(rng.integers(2**63)))
-    names = required_points(spec.subtasks)
-    if d not in ts.tracks:
-        ts.tracks[d] = point_tracks(sim, states, names)
-    progress = progress_from_tracks(
-        point_tracks(sim, roll.states, names), roll.q, ts.tracks[d], spec.subtasks, bounds
-    )
     n = min(cfg.frames or spec.frames, MAX_FRAMES)
-    pos = even_positions(len(roll), n)
-    picked = roll.states[pos]
-    facts = facts_for_states(sim, picked)
-    events = detect_events(spec, facts)
-    frames = ts.renderer.render(picked, cfg.views)
-    prog = np.clip(np.asarray(progress)[pos], 0.0, 1.0)
-    prog[0] = 0.0
+    best = None
+    k = 0
+    for att in make_attempts(
+        sim, spec, level, ts.demos, ts.tracks, cfg.seed, item.index, n, cfg.progress_form
+    ):
+        k = att.tries
+        if best is None or len(att.problems) < len(best.problems):
+            best = att
+        if not att.problems:
+            break
+    assert best is not None
+    roll, pos = best.roll, best.positions
+    sim.reset(ts.demos[best.demo][3])  # the best try's scene (a kitchen's layout, textures)
+    from rover.sim.render import view_centre
+
+    sim.set_state(roll.states[0])
+    frames = ts.renderer.render(roll.states[pos], cfg.views, view_centre(sim))
+    wording, instruction = spec.instruction(cfg.seed * 1_000_003 + item.index)
     truth = GroundTruth(
-        progress=[float(p) for p in prog],
+        progress=[float(p) for p in best.progress],
         state_type=[roll.state_type[p] for p in pos],
         subtasks=_subtasks(spec, roll.subtask[pos]),
-        events=events,
-        facts=facts,
+        events=best.events,
+        facts=best.facts,
         level=item.level,
-        qa=qa_items(spec, events),
+        qa=qa_items(spec, best.events),
     )
-    from rover.sim.env import CONTROL_FREQ
-
-    wording, instruction = spec.instruction(cfg.seed * 1_000_003 + item.index)
     episode = Episode(
         id=item.episode_id,
         task=instruction,
@@ -252,7 +256,8 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
             "sim_task": spec.name,
             "seed": cfg.seed,
             "plan_index": item.index,
-            "demo": d,
+            "tries": k,
+            "demo": best.demo,
             "level_name": level.name,
             "steps": len(roll),
             "deviation": _deviation_summary(roll),
@@ -261,8 +266,9 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
         },
         views=frames,
     )
-    problems = validate_episode(episode, max_level=max(lv.level for lv in spec.levels))
-    if problems:  # kept, but flagged: the dataset report and tests look for these
+    problems = list(best.problems)
+    problems += validate_episode(episode, max_level=max(lv.level for lv in spec.levels))
+    if problems:  # kept, but flagged: `rover validate` and the tests look for these
         episode.extra["problems"] = problems
         _log.warning("%s: %s", episode.id, "; ".join(problems))
     write_episode(out, episode)
@@ -348,7 +354,28 @@ def generate(
         for eid in pool.imap_unordered(_run_item, [(it, cfg, out) for it in todo]):
             written.append(eid)
             report("episodes", len(written), total)
+    write_dataset_info(
+        out,
+        DatasetInfo(
+            name=out.name,
+            views=list(cfg.views),
+            generator={**cfg.model_dump(), "tries": tries_by_level(out)},
+        ),
+    )
     return sorted(written)
+
+
+def tries_by_level(out: Path) -> dict[str, dict[str, list[int]]]:
+    """task -> level -> tries each episode needed to meet its milestone (dataset.json)."""
+    from rover.io.dataset import read_episode
+
+    found: dict[str, dict[str, list[int]]] = {}
+    for eid in episode_ids(out):
+        ep = read_episode(out, eid, load_frames=False)
+        task = str(ep.extra.get("sim_task", ep.task))
+        level = str(ep.truth.level if ep.truth is not None else 0)
+        found.setdefault(task, {}).setdefault(level, []).append(int(ep.extra.get("tries", 1)))
+    return found
 
 
 class _Serial:

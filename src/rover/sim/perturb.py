@@ -11,7 +11,11 @@ executed against a simulator (`execute_plan`). A plan is a flat list of segments
 * `RandomSegment` executes ``w`` actions drawn uniformly from the (scaled) action space
   starting from the current state: a deviation branching at expert index ``q``.
 * `InterpSegment` recovers: ``s_{q,w,z} = interp(s_{q,w}, s^E_{q+h}, z / n_interp)`` for
-  ``z = 1 .. z_stop``. The state at ``z = n_interp`` equals ``s^E_{q+h}`` and is recorded
+  ``z = 1 .. z_stop``. With a simulator that offers ``drive_robot`` (rover's `SimEnv`),
+  only the robot's joints are interpolated and the rest is simulated, so free objects
+  never teleport (the paper interpolates the whole state); `Rollout.recovery_gap` then
+  says how far an object ends from the expert state the recovery hands over to. The state
+  at ``z = n_interp`` equals ``s^E_{q+h}`` and is recorded
   by the `ExpertSegment` starting at ``q + h``; a nested deviation may cut the recovery
   short (``z_stop < n_interp``) and start its own recovery from where it ends.
 
@@ -105,6 +109,9 @@ class Rollout:
     subtask: np.ndarray  # (N,) subtask index of q
     terminated: bool
     plan: TrajectoryPlan | None = field(default=None, repr=False)
+    # m: the largest jump of a task object where a physical recovery hands over to the
+    # recorded expert (0 when recoveries are plain interpolation or none happen)
+    recovery_gap: float = 0.0
 
     def __len__(self) -> int:
         return int(self.states.shape[0])
@@ -285,6 +292,7 @@ def execute_plan(
     idx: list[tuple[int, int, int, int]] = []
     types: list[StateType] = []
     j_total = 0
+    mismatch = 0.0
 
     def record(s: np.ndarray, q: int, j: int, z: int, d: int, t: StateType) -> None:
         states.append(np.array(s, dtype=np.float64, copy=True))
@@ -316,9 +324,18 @@ def execute_plan(
         else:
             start = states[-1]
             goal = expert_states[seg.target]
+            physical = hasattr(adapter, "drive_robot")
+            if physical:
+                adapter.set_state(start)
             for z in range(1, seg.z_stop + 1):
-                s = adapter.interpolate(start, goal, z / seg.n_interp)
+                if physical:  # robot interpolated, the rest simulated (no teleports)
+                    adapter.drive_robot(start, goal, (z - 1) / seg.n_interp, z / seg.n_interp)
+                    s = adapter.get_state()
+                else:
+                    s = adapter.interpolate(start, goal, z / seg.n_interp)
                 record(s, seg.q, j_total, z, seg.depth, StateType.interpolating)
+            if physical:
+                mismatch = max(mismatch, _object_gap(adapter, adapter.get_state(), goal))
     arr = np.stack(states)
     ij = np.asarray(idx, dtype=np.int64)
     return Rollout(
@@ -331,4 +348,16 @@ def execute_plan(
         subtask=subtask_of(ij[:, 0], plan.subtask_bounds),
         terminated=plan.terminated,
         plan=plan,
+        recovery_gap=mismatch,
     )
+
+
+def _object_gap(adapter: SimAdapter, state: np.ndarray, expert: np.ndarray) -> float:
+    """How far (m) any task object is from where the expert state has it: the jump the
+    video would show when a physical recovery hands over to the recorded expert."""
+    adapter.set_state(state)
+    here = np.asarray(adapter.entity_positions())[1:]
+    adapter.set_state(expert)
+    there = np.asarray(adapter.entity_positions())[1:]
+    adapter.set_state(state)
+    return float(np.linalg.norm(here - there, axis=-1).max()) if len(here) else 0.0

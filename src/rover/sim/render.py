@@ -5,8 +5,10 @@ video and renders each view here with one `mujoco.Renderer` on the task's model 
 private `MjData` (so rendering never disturbs the simulation). Views:
 
 - ``wrist``: robosuite's eye-in-hand camera on the Panda hand.
-- ``left`` / ``right``: free cameras looking at the workspace from the front-left and
-  front-right of the robot (no model edit needed, so robosuite/RoboCasa models load as is).
+- ``left`` / ``right``: free cameras beside the robot, on its left and on its right,
+  looking past the arm at the task (no model edit needed, so robosuite/RoboCasa models
+  load as is). The generator aims them at the task's centre (`view_centre`: gripper,
+  objects and goals at the start), so every task's objects and gripper are in frame.
 - any camera name in the model (``frontview``, ``agentview``, ...) also works.
 
 Cost is geometry-bound on a CPU rasteriser, so multisampling is off, the offscreen buffer
@@ -41,10 +43,12 @@ class FreeView:
 
 
 # Workspace views for robosuite's table tasks (table top centre ~ (0, 0, 0.8); the robot
-# base stands at x ~ -0.56 looking along +x). Azimuth 180 would look from the front.
+# base stands at x ~ -0.56 looking along +x). A free camera sits at
+# lookat - distance * (cos el cos az, cos el sin az, sin el): azimuth -60 puts it behind
+# and to the left of the task (the robot's left, +y), +60 to its right.
 FREE_VIEWS: dict[str, FreeView] = {
-    "left": FreeView(lookat=(0.0, 0.0, 0.9), distance=1.35, azimuth=-125.0, elevation=-32.0),
-    "right": FreeView(lookat=(0.0, 0.0, 0.9), distance=1.35, azimuth=125.0, elevation=-32.0),
+    "left": FreeView(lookat=(0.0, 0.0, 0.9), distance=1.45, azimuth=-60.0, elevation=-30.0),
+    "right": FreeView(lookat=(0.0, 0.0, 0.9), distance=1.45, azimuth=60.0, elevation=-30.0),
 }
 VIEW_NAMES = ["wrist", "left", "right"]
 
@@ -100,10 +104,13 @@ class StateRenderer:
         mujoco.mj_kinematics(m, d)
         mujoco.mj_camlight(m, d)
 
-    def render(self, states: np.ndarray, views: list[str]) -> dict[str, np.ndarray]:
-        """Frames (T, H, W, 3) uint8 per view for each state in order."""
+    def render(
+        self, states: np.ndarray, views: list[str], lookat: np.ndarray | None = None
+    ) -> dict[str, np.ndarray]:
+        """Frames (T, H, W, 3) uint8 per view for each state in order; free views look at
+        `lookat` (default: the table centre)."""
         check_views(views)
-        cams = {v: self.camera(v) for v in views}
+        cams = {v: self.camera(v, lookat) for v in views}
         out = {v: np.empty((len(states), self.height, self.width, 3), np.uint8) for v in views}
         for t, state in enumerate(states):
             self.set_state(np.asarray(state, dtype=np.float64))
@@ -117,3 +124,16 @@ class StateRenderer:
 
     def close(self) -> None:
         self.renderer.close()
+
+
+def view_centre(sim) -> np.ndarray:
+    """Where the free views look for a task: the middle of the gripper, the task objects
+    and their goals in the simulator's current state (an episode's first state)."""
+    pts = [sim.point("eef")] + [sim.point(o.name) for o in sim.spec.objects]
+    for s in sim.spec.subtasks:
+        if s.goal is not None:
+            pts.append(sim.point(s.goal))
+    lo, hi = np.min(pts, axis=0), np.max(pts, axis=0)
+    centre = (lo + hi) / 2
+    centre[2] = min(max(centre[2], 0.85), 1.0)  # about the table top, never the ceiling
+    return centre

@@ -29,7 +29,13 @@ def _lifted(f: FrameFacts, obj: str) -> bool:
 
 def _placed(f: FrameFacts, obj: str) -> bool:
     o = f.objects.get(obj)
-    return o is None or o.inside is not None or o.on is not None
+    if f.holding == obj:
+        return False
+    return o is None or o.inside not in (None, "start bin") or o.on not in (None, "table")
+
+
+def _held(f: FrameFacts, obj: str) -> bool:
+    return f.holding == obj
 
 
 def _pressed(f: FrameFacts, obj: str) -> bool:
@@ -40,13 +46,16 @@ def _opening(f: FrameFacts, obj: str) -> bool:
     return obj not in f.articulations or f.articulations[obj] > 0.0
 
 
+# events that mark a hold beginning (True) or ending (False): the frame before must differ
+HOLD_CHANGE = {"grasp": True, "drop": False, "place": False}
+
 # event name -> (what must hold at the event frame, wording for the problem message)
 EVENT_RULES: dict[str, tuple[Callable[[FrameFacts, str], bool], str]] = {
     "contact": (_holds_or_touches, "the gripper does not touch it"),
-    "grasp": (_holds_or_touches, "it is neither held nor touched"),
-    "pick_up": (_lifted, "it is neither held nor lifted"),
-    "drop": (lambda f, o: f.holding != o, "it is still held"),
-    "place": (_placed, "it is neither inside nor on anything"),
+    "grasp": (_held, "it is not held"),
+    "pick_up": (lambda f, o: _held(f, o) and _lifted(f, o), "it is not held off its start"),
+    "drop": (lambda f, o: f.holding != o and not _placed(f, o), "it is held or in its goal"),
+    "place": (_placed, "it is held, or neither inside nor on its goal"),
     "press": (_pressed, "it is not pressed"),
     "open_start": (_opening, "its opening is 0"),
     "open_finish": (_opening, "its opening is 0"),
@@ -63,9 +72,18 @@ def event_problems(event: Event, facts: list[FrameFacts]) -> list[str]:
     if rule is None:
         return []
     check, why = rule
-    if check(facts[event.frame], event.object):
-        return []
-    return [f"event {event.name} {event.object!r} at frame {event.frame}, but {why} there"]
+    if not check(facts[event.frame], event.object):
+        return [f"event {event.name} {event.object!r} at frame {event.frame}, but {why} there"]
+    begins = HOLD_CHANGE.get(event.name)
+    if begins is not None and event.frame > 0:
+        before = _held(facts[event.frame - 1], event.object)
+        if before == begins:
+            state = "already held" if begins else "not held"
+            return [
+                f"event {event.name} {event.object!r} at frame {event.frame}, but it was "
+                f"{state} the frame before"
+            ]
+    return []
 
 
 def validate_episode(episode: Episode, max_level: int | None = None) -> list[str]:

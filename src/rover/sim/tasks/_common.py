@@ -58,6 +58,13 @@ def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
     )
 
 
+def pick_place_milestones(obj: str) -> list[str]:
+    """The six components separating the seven pick-and-place levels."""
+    return [
+        f"{k}:{obj}" for k in ("approach", "contact", "pick_up", "carry", "approach_goal", "place")
+    ]
+
+
 def pick_place_qa(obj: str, target: str) -> list[QATemplate]:
     """App. C.3 pick-and-place questions for one object."""
     return [

@@ -54,6 +54,7 @@ def _drawer_task(name: str, closing: bool) -> TaskSpec:
                 robot_points=FINGERS,
                 object_points=["drawer:handle", "drawer:handle"],
                 goal=f"goal:drawer_{verb}",
+                joint="joint:drawer",
                 beta=0.8,
                 end_signal=f"{signal}:drawer",
             ),
@@ -68,6 +69,12 @@ def _drawer_task(name: str, closing: bool) -> TaskSpec:
                 f"Finish {ing} the drawer",
             ],
         ),
+        milestones=[
+            "approach:drawer",
+            "contact:drawer",
+            f"{verb}_start:drawer",
+            f"{verb}_finish:drawer",
+        ],
         qa_templates=_qa(
             [
                 ("did_contact", "Did the robot contact the drawer handle? If so, when?", "contact"),
@@ -122,6 +129,7 @@ PRESS_BUTTON = TaskSpec(
             robot_points=FINGERS,
             object_points=["button:top", "button:top"],
             goal="goal:button_pressed",
+            joint="joint:button",
             beta=0.8,
             end_signal="pressed:button",
         ),
@@ -134,6 +142,7 @@ PRESS_BUTTON = TaskSpec(
             "Press the button and turn the appliance on",
         ],
     ),
+    milestones=["approach:button", "press:button"],
     qa_templates=_qa(
         [
             ("did_contact", "Did the robot contact the button? If so, when?", "contact"),
@@ -175,6 +184,7 @@ TURN_KNOB = TaskSpec(
             robot_points=FINGERS,
             object_points=["knob:tip", "knob:tip"],
             goal="goal:knob_turned",
+            joint="joint:knob",
             beta=0.8,
             end_signal="turned:knob",
         ),
@@ -189,6 +199,7 @@ TURN_KNOB = TaskSpec(
             "Finish turning the knob",
         ],
     ),
+    milestones=["approach:knob", "contact:knob", "turn_start:knob", "turn_finish:knob"],
     qa_templates=_qa(
         [
             ("did_contact", "Did the robot contact the knob? If so, when?", "contact"),

@@ -81,6 +81,9 @@ class SubtaskSpec(BaseModel):
     goal: str | None = None  # named point for y^{e,f}, e.g. "goal:bin"; None: no goal term
     beta: float = 0.0  # weight of the goal term in [0, 1]
     end_signal: str  # predicate the env evaluates, e.g. "lifted:can", "placed:can"
+    # articulated goal: point "joint:<object>" (fraction of the joint's way to its goal);
+    # progress measures the goal term by it rather than by the goal point's distance
+    joint: str | None = None
 
 
 class QATemplate(BaseModel):
@@ -105,6 +108,9 @@ class TaskSpec(BaseModel):
     goals: dict[str, GoalSpec] = Field(default_factory=dict)
     subtasks: list[SubtaskSpec]
     levels: list[LevelSpec]
+    # Table 5 components in order ("approach:can", "pick_up:can", ...): level L shows the
+    # first L-1 and not the L-th (`rover.sim.milestones`)
+    milestones: list[str] = Field(default_factory=list)
     qa_templates: list[QATemplate] = Field(default_factory=list)
     frames: int = 30  # frames per video: 30 for atomic tasks, 60 for composite ones
     expert: str  # scripted expert name in `rover.sim.experts`

@@ -39,6 +39,7 @@ def restock_task(items: tuple[str, ...] = ITEMS) -> TaskSpec:
         bins={o: BIN_OF[o] for o in items},
         subtasks=subtasks,
         levels=levels,
+        milestones=[f"{k}:{o}" for o in items for k in ("pick_up", "place")],
         qa_templates=qa,
         frames=60,
         expert="pick_place",

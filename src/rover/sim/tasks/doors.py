@@ -31,6 +31,7 @@ DOOR = TaskSpec(
             robot_points=FINGERS,
             object_points=["door:handle", "door:handle"],
             goal="goal:door_open",
+            joint="joint:door",
             beta=0.8,
             end_signal="opened:door",
         ),
@@ -45,6 +46,7 @@ DOOR = TaskSpec(
             "Finish opening the door",
         ],
     ),
+    milestones=["approach:door", "contact:door", "open_start:door", "open_finish:door"],
     qa_templates=[
         QATemplate(
             id="did_contact",

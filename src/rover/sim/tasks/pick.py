@@ -20,6 +20,7 @@ LIFT = TaskSpec(
         [["Approach the cube"], []],
         ["Fail to approach the cube", "Approach the cube", "Contact the cube", "Pick up the cube"],
     ),
+    milestones=["approach:cube", "contact:cube", "pick_up:cube"],
     qa_templates=[
         QATemplate(
             id="did_contact",

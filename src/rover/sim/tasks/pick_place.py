@@ -6,6 +6,7 @@ from rover.sim.tasks._common import (
     grasp_subtask,
     move_subtask,
     pick_place_levels,
+    pick_place_milestones,
     pick_place_qa,
 )
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
@@ -35,6 +36,7 @@ def pick_place_task(obj: str) -> TaskSpec:
             move_subtask(f"place the {obj} {target}", obj, "goal:bin", f"placed:{obj}"),
         ],
         levels=pick_place_levels(obj, target),
+        milestones=pick_place_milestones(obj),
         qa_templates=pick_place_qa(obj, target),
         expert="pick_place",
         max_expert_steps=500,
@@ -66,6 +68,7 @@ def nut_task(shape: str) -> TaskSpec:
             move_subtask(f"place the {nut} {target}", nut, "goal:peg", f"on_peg:{nut}"),
         ],
         levels=pick_place_levels(nut, target),
+        milestones=pick_place_milestones(nut),
         qa_templates=pick_place_qa(nut, target),
         expert="nut",
         max_expert_steps=500,

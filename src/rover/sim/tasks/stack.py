@@ -6,6 +6,7 @@ from rover.sim.tasks._common import (
     grasp_subtask,
     move_subtask,
     pick_place_levels,
+    pick_place_milestones,
     pick_place_qa,
 )
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
@@ -27,6 +28,7 @@ STACK = TaskSpec(
         move_subtask(f"place the red cube {TARGET}", "red cube", "goal:on", "stacked:red cube"),
     ],
     levels=pick_place_levels("red cube", TARGET),
+    milestones=pick_place_milestones("red cube"),
     qa_templates=pick_place_qa("red cube", TARGET),
     expert="stack",
     max_expert_steps=400,

@@ -1,0 +1,76 @@
+"""Level milestones (App. B, Table 5) checked from an episode's own facts and events.
+
+A task lists its components in order, e.g. pick-and-place: approach the can, contact it,
+pick it up, keep the grasp while carrying it, bring it over its target, place it. Level
+L of a task means: components 1..L-1 achieved, component L not (the top level achieves
+all of them). Each component is ``"<kind>:<object>"``:
+
+* ``approach``: the gripper comes within `APPROACH` of the point the object is taken by;
+* ``carry``: the object is held off its start for `CARRY_FRAMES` frames in a row;
+* ``approach_goal``: the object, held, is within `APPROACH_GOAL` of its goal in the table
+  plane (over its bin, peg or the cube below);
+* any event name (``contact``, ``pick_up``, ``place``, ``open_start``, ``press``, ...):
+  the event happens in the video.
+
+Everything here reads `rover.episode` types only (no MuJoCo), so the generator's check
+and the `rover validate` audit are the same code.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from rover.episode import Event, FrameFacts
+
+APPROACH = 0.10  # m from the gripper to the grip point that counts as "approached"
+APPROACH_GOAL = 0.08  # m (table plane) from a held object to its goal: "over the target"
+CARRY_FRAMES = 4  # consecutive frames held and lifted that count as "kept the grasp"
+
+
+def achieved(component: str, facts: Sequence[FrameFacts], events: Sequence[Event]) -> bool:
+    """Whether the video shows one component (see the module docstring for the kinds)."""
+    kind, _, obj = component.partition(":")
+    if kind == "approach":
+        return any(
+            (o := f.objects.get(obj)) is not None and o.reach is not None and o.reach <= APPROACH
+            for f in facts
+        )
+    if kind == "carry":
+        run = 0
+        for f in facts:
+            o = f.objects.get(obj)
+            run = run + 1 if f.holding == obj and o is not None and o.lifted else 0
+            if run >= CARRY_FRAMES:
+                return True
+        return False
+    if kind == "approach_goal":
+        return any(
+            f.holding == obj
+            and (o := f.objects.get(obj)) is not None
+            and o.goal_distance is not None
+            and o.goal_distance <= APPROACH_GOAL
+            for f in facts
+        )
+    return any(e.name == kind and e.object == obj and e.frame is not None for e in events)
+
+
+def level_problems(
+    level: int,
+    components: Sequence[str],
+    facts: Sequence[FrameFacts],
+    events: Sequence[Event],
+) -> list[str]:
+    """Why an episode does not show its level (empty: it does).
+
+    Level L needs components 1..L-1 and must not show component L.
+    """
+    out: list[str] = []
+    need = list(components[: max(level - 1, 0)])
+    for c in need:
+        if not achieved(c, facts, events):
+            out.append(f"level {level} needs {c!r}, which the video never shows")
+    if level - 1 < len(components):
+        nxt = components[level - 1]
+        if achieved(nxt, facts, events):
+            out.append(f"level {level} must stop before {nxt!r}, but the video shows it")
+    return out
