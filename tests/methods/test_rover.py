@@ -248,3 +248,35 @@ async def test_images_are_encoded_once(make_episode, scripted):
             assert isinstance(part, ImagePart)
             by_frame.setdefault(part.frame_index, set()).add(id(part.image))
     assert all(len(ids) == 1 for ids in by_frame.values())
+
+
+def chatty_script(p: Prompt) -> str:
+    """A model that plans two subtasks and writes "needs to" prose in every description."""
+    m = p.meta
+    if m.kind == "rover.parent":
+        if m.extra["completed"] == ["grasp the can"]:
+            return "Sure.\n\n**The robot needs to:** place the can in the bin"
+        return "**Task complete.**"
+    if m.subtask_path == []:
+        return (
+            "### Frame description\nThe arm is above the can; the robot needs to grasp it.\n\n"
+            "### New subtasks\n1. grasp the can\n2. place the can in the bin\n\n"
+            "The robot needs to: grasp the can"
+        )
+    pos, first = m.positions[-1], m.extra["first_position"]
+    value = min(100, 50 * (pos - first))
+    return (
+        f"Frame description: The gripper moves, so the robot needs to keep going. "
+        f"To finish, the robot needs to close it. Subtask completion percentage: {value}% "
+        "[next-frame]"
+    )
+
+
+async def test_prose_needs_to_never_nests_and_the_plan_is_followed(make_episode, scripted):
+    trace = await get_method("rover").run(make_episode(7), scripted(chatty_script))
+    root = trace.tree
+    assert root.planned_subtasks == ["grasp the can", "place the can in the bin"]
+    assert [c.subtask for c in root.children] == ["grasp the can", "place the can in the bin"]
+    assert all(c.children == [] for c in root.children)  # no line four deep
+    assert trace.progress()[-1] == pytest.approx(100)
+    assert trace.frames[1].description.startswith("The gripper moves, so the robot needs to")

@@ -243,6 +243,8 @@ def _label_ok(line: str, m: re.Match[str], kind: str) -> bool:
             return False  # inside a sentence: prose, not a label
         if kind == "desc" and m.group("desc").lower() == "description":
             return False
+    if kind == "plan" and at_start and not rest:
+        return True  # "### New subtasks" as a heading over a list
     if kind in ("needs", "plan", "sub"):
         return colon  # the decomposition markers count only with their colon
     if kind == "pct":

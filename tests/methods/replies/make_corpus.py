@@ -108,6 +108,15 @@ DECOMPOSE_STYLES = {
         True,
     ),
     "lowercase-period": ("frame description: {D}\nthe robot needs to: {S}.", False),
+    "heading-plan": (
+        "### Frame description\n{D}\n\n### New subtasks\n1. {S}\n2. {S2}\n\n"
+        "The robot needs to: {S}",
+        True,
+    ),
+    "bold-heading-plan": (
+        "**Frame description:** {D}\n**New subtasks**\n- {S}\n- {S2}\n**The robot needs to:** {S}",
+        True,
+    ),
     "bold-label": ("**Frame description:** {D}\n\n**The robot needs to:** {S}.", False),
 }
 
