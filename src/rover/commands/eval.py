@@ -44,7 +44,7 @@ def eval_command(
     task: Annotated[
         str | None,
         typer.Option(
-            "--task", help="With --source: task text for sources that carry none (one task)."
+            "--task", help="With --source: the task text of every episode (single-task sources)."
         ),
     ] = None,
     methods: Annotated[
