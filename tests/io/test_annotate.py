@@ -14,7 +14,7 @@ import threading
 import pytest
 from typer.testing import CliRunner
 
-from rover.annotate import AnnotateOptions, run_annotate
+from rover.annotate import AnnotateOptions, plan_annotation, run_annotate
 from rover.cli import app
 from rover.errors import InputError
 from rover.io.source import open_source
@@ -181,6 +181,10 @@ def test_annotate_other_sources_with_sample(tmp_path, make_rlds, make_robomimic)
     assert result.annotated == 2 and not result.failed and vlm.calls == result.calls
     episodes = pq.read_table(result.episodes_path).to_pylist()
     assert len(episodes) == 2 and all(0 <= e["episode_index"] < 3 for e in episodes)
+    with pytest.raises(InputError, match="clip-value needs --model-path"):
+        plan_annotation(
+            AnnotateOptions(source=f"rlds:{rlds}", out=tmp_path / "c", method="clip-value")
+        )
     h5 = make_robomimic(tmp_path / "demo.hdf5", lengths=(5, 4), task="")
     with pytest.raises(InputError, match="carries no task description"):
         asyncio.run(run_annotate(AnnotateOptions(source=f"hdf5:{h5}", out=tmp_path / "b")))

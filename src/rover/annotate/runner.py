@@ -57,6 +57,7 @@ class AnnotateSettings(BaseModel):
     view: str | None = None
     task: str | None = None
     success_threshold: float = 95.0
+    model_path: str | None = None
 
 
 @dataclass
@@ -80,6 +81,7 @@ class AnnotateOptions:
     concurrency: int = 4
     resume: bool = False
     in_place: bool = False
+    model_path: Path | None = None  # clip-value: the local CLIP/SigLIP folder
     vlm: Any = None
 
     def settings(self) -> AnnotateSettings:
@@ -93,6 +95,7 @@ class AnnotateOptions:
             view=self.view,
             task=self.task,
             success_threshold=self.success_threshold,
+            model_path=None if self.model_path is None else str(self.model_path),
         )
 
 
@@ -167,6 +170,10 @@ def plan_annotation(opts: AnnotateOptions) -> Planned:
         raise InputError(
             f"unknown method {opts.method!r}; valid methods: {', '.join(method_names())}"
         )
+    if opts.method == "clip-value" and (
+        opts.model_path is None or not Path(opts.model_path).is_dir()
+    ):
+        raise InputError("clip-value needs --model-path: a local CLIP or SigLIP folder")
     if opts.concurrency < 1:
         raise InputError(f"--concurrency must be at least 1, got {opts.concurrency}")
     if opts.frames is not None and opts.frames < 2:
@@ -220,7 +227,7 @@ async def run_annotate(
         from rover.vlm.loader import load_vlm
 
         vlm = load_vlm(opts.backend, opts.backend_config)
-    params = {"window": opts.window, "seed": opts.seed}
+    params = {"window": opts.window, "seed": opts.seed, "model_path": opts.model_path}
     result = AnnotateResult(episodes=len(planned.episodes), skipped=len(planned.done))
     errors = _read_errors(out)
     sem = asyncio.Semaphore(opts.concurrency)

@@ -63,6 +63,9 @@ def annotate_command(
     window: Annotated[
         int | None, typer.Option("--window", help="ROVER window size K (default 3).")
     ] = None,
+    model_path: Annotated[
+        Path | None, typer.Option("--model-path", help="clip-value: local CLIP/SigLIP folder.")
+    ] = None,
     success_threshold: Annotated[
         float,
         typer.Option("--success-threshold", help="Final progress (%) that counts as success."),
@@ -130,6 +133,7 @@ def annotate_command(
         concurrency=concurrency,
         resume=resume,
         in_place=in_place,
+        model_path=model_path,
     )
     planned = plan_annotation(opts)
     console = Console(highlight=False)
