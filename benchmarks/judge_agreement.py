@@ -1,7 +1,7 @@
 """Agreement of the Task 2 judges and Task 3 answerers with the labelled corpus.
 
     python benchmarks/judge_agreement.py [--split heldout|dev|all] [--json PATH]
-                                         [--no-write] [--misses N]
+                                         [--no-write] [--misses N] [--model SPEC]
 
 Runs, on one half of `rover/eval/agreement/` (held-out by default):
 
@@ -13,7 +13,9 @@ Runs, on one half of `rover/eval/agreement/` (held-out by default):
   verdict) through a loopback OpenAI-compatible server whose scripted model always means
   the label but formats its reply the way chat models do (markdown, prose around the
   fields, bullet lists, JSON, a lost last line). This measures our side of the LLM judge;
-  the model's own agreement needs a real model (the paper measured 97.5% for GPT-4.5).
+  the model's own agreement needs a real model (the paper measured 97.5% for GPT-4.5):
+  `--model SPEC` runs the same cases through that backend as judge and answerer, and
+  stores its numbers so `rover eval --judge SPEC` summaries can quote them.
 
 The paper's bar (App. C.2) and this project's: at least 90% on the held-out half for the
 rule judge and the rule answerer. With the default split and without --no-write it
@@ -61,6 +63,24 @@ async def _llm_paths(fcases, qcases) -> tuple[Agreement, Agreement]:
     return judge, qa
 
 
+async def _model_paths(spec: str, fcases, qcases) -> tuple[Agreement, Agreement]:
+    """The LLM judge and answerer through a real backend (cached like method calls)."""
+    from rover.vlm.config import BackendConfig
+    from rover.vlm.loader import load_vlm
+
+    vlm = load_vlm(spec, BackendConfig())
+    return await llm_judge_agreement(fcases, vlm), await llm_qa_agreement(qcases, vlm)
+
+
+def _previous_models() -> dict:
+    """Models measured before, kept while the corpus is the same version."""
+    try:
+        old = json.loads(MEASURED.read_text())
+    except (OSError, ValueError):
+        return {}
+    return old.get("models", {}) if old.get("corpus_version") == CORPUS_VERSION else {}
+
+
 # --- tables -------------------------------------------------------------------------------
 
 
@@ -102,7 +122,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", type=Path, help="write every number here as JSON")
     ap.add_argument("--no-write", action="store_true", help="do not update measured.json")
     ap.add_argument("--misses", type=int, default=15, help="disagreements to list per judge")
+    ap.add_argument(
+        "--model",
+        help="also measure a real LLM as judge and answerer (any backend spec, e.g. "
+        "openai:gpt-4o); its numbers are stored under that spec and shown on its card",
+    )
     args = ap.parse_args(argv)
+    if args.model:
+        from rover.vlm.loader import parse_spec
+
+        try:
+            if parse_spec(args.model)[0] == "oracle":
+                raise ValueError("the oracle cannot judge")
+        except Exception as e:  # noqa: BLE001 - one line, before any call
+            print(f"error: --model {args.model!r}: {e}", file=sys.stderr)
+            return 2
 
     def pick(cases):
         return list(cases) if args.split == "all" else split(cases, args.split)
@@ -111,6 +145,7 @@ def main(argv: list[str] | None = None) -> int:
     rule_j = rule_judge_agreement(fcases)
     rule_q = rule_qa_agreement(qcases)
     llm_j, llm_q = asyncio.run(_llm_paths(fcases, qcases))
+    model = asyncio.run(_model_paths(args.model, fcases, qcases)) if args.model else None
 
     by_id = {c.id: c for c in fcases} | {c.id: c for c in qcases}
     print(
@@ -125,6 +160,11 @@ def main(argv: list[str] | None = None) -> int:
     print()
     print(_table("LLM judge path, scripted model", llm_j, VERDICTS))
     print(_table("LLM answerer path, scripted model", llm_q, ANSWERS))
+    if model is not None:
+        print(_table(f"LLM judge {args.model}", model[0], VERDICTS))
+        print(_misses(model[0], by_id, args.misses))
+        print(_table(f"LLM answerer {args.model}", model[1], ANSWERS))
+        print(_misses(model[1], by_id, args.misses))
     ok = rule_j.rate >= TARGET and rule_q.rate >= TARGET
     print(
         f"\ntarget >= {100 * TARGET:.0f}% for the rule judge and answerer: "
@@ -142,12 +182,17 @@ def main(argv: list[str] | None = None) -> int:
             "llm_judge_scripted": llm_j.as_json(),
             "llm_answerer_scripted": llm_q.as_json(),
         },
+        "models": _previous_models(),
     }
+    if model is not None:
+        result["models"][args.model] = {"judge": model[0].as_json(), "answerer": model[1].as_json()}
     if args.json:
         args.json.write_text(json.dumps(result, indent=1) + "\n")
     if args.split == "heldout" and not args.no_write:
         slim = json.loads(json.dumps(result))
-        for entry in slim["judges"].values():
+        entries = list(slim["judges"].values())
+        entries += [e for m in slim["models"].values() for e in m.values()]
+        for entry in entries:
             entry.pop("misses", None)
         MEASURED.write_text(json.dumps(slim, indent=1) + "\n")
         print(f"wrote {MEASURED.relative_to(MEASURED.parents[4])}")

@@ -136,3 +136,15 @@ def test_judge_cards_name_the_judge_and_its_measured_agreement() -> None:
     assert judge_card("answerer", "none") is None
     with pytest.raises(ValueError):
         judge_card("grader")
+
+
+def test_a_measured_model_gets_its_own_card(monkeypatch) -> None:
+    from rover.eval import judge_cards
+
+    stored = dict(measured())
+    stored["models"] = {"openai:judge-x": {"judge": {"agreement": 0.9, "n": 312}}}
+    monkeypatch.setattr(judge_cards, "measured", lambda: stored)
+    card = judge_cards.judge_card("judge", "openai:judge-x")
+    assert card is not None and card.agreement == 0.9 and "90.0% on 312" in card.line()
+    other = judge_cards.judge_card("answerer", "openai:judge-x")  # only its judge measured
+    assert other is not None and other.agreement is None

@@ -7,10 +7,10 @@ writes `rover/eval/agreement/measured.json`. That file is the one place the agre
 lives; run summaries and the report read it through `judge_card`, so a judge is never
 named without its measured agreement (or without saying that it was not measured).
 
-An LLM judge (`openai:...`, `gemini:...`) has no card of its own: its agreement depends
-on the model, which the benchmark cannot call offline. Its card says so and carries the
-agreement of the LLM path measured with a scripted model (prompt, reply parsing and
-verdict rule only).
+An LLM judge (`openai:...`, `gemini:...`) has a measured card only once someone ran the
+benchmark with `--model SPEC` against that model (its numbers are stored under the spec).
+Otherwise its card says the agreement was not measured and carries that of the LLM path
+with a scripted model (prompt, reply parsing and verdict rule only).
 """
 
 from __future__ import annotations
@@ -114,6 +114,11 @@ def judge_card(kind: str, spec: str = "rule") -> JudgeCard | None:
             corpus,
             fresh_agreement=float(fresh["agreement"]) if fresh else None,
             fresh_n=int(fresh["n"]) if fresh else 0,
+        )
+    model = measured().get("models", {}).get(spec, {}).get(kind)
+    if isinstance(model, dict):
+        return JudgeCard(
+            kind, spec, f"LLM {spec}", float(model["agreement"]), int(model["n"]), corpus
         )
     scripted = _entry(_LLM_KEYS[kind])
     note = "its agreement depends on the model; the paper measured 97.5% for GPT-4.5."
