@@ -228,6 +228,9 @@ def generate_episode(item: WorkItem, cfg: GenerateConfig, out: Path) -> str:
     assert best is not None
     roll, pos = best.roll, best.positions
     sim.reset(ts.demos[best.demo][3])  # the best try's scene (a kitchen's layout, textures)
+    restyle = getattr(sim.env, "restyle", None)
+    if restyle is not None:  # a kitchen: this episode's own textures, light and camera
+        restyle(cfg.seed * 1_000_003 + item.index)
     from rover.sim.render import view_centre
 
     sim.set_state(roll.states[0])

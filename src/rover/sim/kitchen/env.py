@@ -13,6 +13,7 @@ fixtures work here unchanged.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 from pathlib import Path
 
 import mujoco
@@ -28,7 +29,7 @@ from rover.sim.fixtures.button import PRESS_Q
 from rover.sim.fixtures.drawer import OPEN_Q
 from rover.sim.kitchen.fixtures import COUNTER_SIZE, COUNTER_TOP, FIXTURES
 from rover.sim.kitchen.objects import CATALOGUE, build_object, draw_decor, half_height, make_static
-from rover.sim.kitchen.scene import TEXTURES, Scene, draw_scene
+from rover.sim.kitchen.scene import TEXTURES, Scene, draw_scene, draw_style
 
 TEXTURE_DIR = Path(robosuite.__file__).resolve().parent / "models" / "assets" / "textures"
 HIDDEN_X = 6.0  # m: unused fixtures stand on the floor outside the room's walls
@@ -209,6 +210,18 @@ class RoverKitchen(FixtureEnv):
         self.sim.data.qpos[self.joint_qpos_addr] = self.start_q
         self.sim.data.qvel[self.model_dof_addr()] = 0.0
         self.sim.forward()
+
+    def restyle(self, seed: int) -> None:
+        """Redraw this scene's look (textures, light, camera) from `seed`; layout stays.
+
+        The generator calls it per episode, so episodes replaying one demonstration
+        (same layout, same physics) still show different kitchens.
+        """
+        if self.scene is None:
+            raise RuntimeError("restyle before the first reset")
+        style = draw_style(np.random.default_rng([int(seed), 0x5C3E]))
+        self.scene = replace(self.scene, **style)
+        self.apply_scene(self.scene)
 
     def apply_scene(self, scene: Scene) -> None:
         """Pose fixtures and décor, switch surface materials, jitter light and cameras."""

@@ -103,14 +103,20 @@ def draw_layout(rng: np.random.Generator, used: list[str]) -> dict[str, Placemen
 def draw_scene(rng: np.random.Generator, used: list[str], decor: list[dict]) -> Scene:
     """One kitchen: layout, a texture per surface, light and camera modder seeds."""
     layout = draw_layout(rng, used)
-    textures = {s: str(options[int(rng.integers(len(options)))]) for s, options in TEXTURES.items()}
-    return Scene(
-        layout=layout,
-        textures=textures,
-        light_seed=int(rng.integers(2**31)),
-        camera_seed=int(rng.integers(2**31)),
-        decor=decor,
-    )
+    return Scene(layout=layout, decor=decor, **draw_style(rng))
+
+
+def draw_style(rng: np.random.Generator) -> dict:
+    """The purely visual part of a scene: textures, light and camera modder seeds.
+
+    Nothing physical depends on it, so an episode may redraw it (`restyle`) while
+    replaying a demonstration recorded in the same layout.
+    """
+    return {
+        "textures": {s: str(opts[int(rng.integers(len(opts)))]) for s, opts in TEXTURES.items()},
+        "light_seed": int(rng.integers(2**31)),
+        "camera_seed": int(rng.integers(2**31)),
+    }
 
 
 def scene_record(sim) -> dict:
