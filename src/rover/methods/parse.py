@@ -3,13 +3,13 @@
 Real VLMs rarely follow the answer format to the letter: they bold or italicise the
 labels, write headings with the value underneath, answer in JSON or markdown tables, put
 every field on one line, write "45.5 %", "-10%" or "about 120 percent", or add chatter.
-The line grammar in `reply_grammar` reads the fields; this module turns them into what
-each method branches on. Every function returns `None` (or an empty result) for a reply
-it cannot use instead of raising, so the methods can re-ask once with a format reminder
-and then record a parse failure, carrying the last value forward.
+The line grammar (`reply_grammar`, `reply_fields`) reads the fields; this module turns
+them into what each method branches on. Every function returns `None` (or an empty
+result) for a reply it cannot use instead of raising, so the methods can re-ask once with
+a format reminder and then record a parse failure, carrying the last value forward.
 
-Work is linear in the reply's length, and only the first `MAX_PARSE_CHARS` (64 KB) of a
-reply are read (`reply_capped` says when a reply was longer; the trace records it).
+Work is linear in the reply's length, and only a reply's first 64 KB and 2,000 lines are
+read (`reply_capped` says when a reply was longer; the trace records it).
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from rover.methods.reply_fields import Fields, read_fields
 from rover.methods.reply_grammar import (
     MAX_PARSE_CHARS,
-    Fields,
     Line,
     any_percentage,
     cap,
@@ -30,7 +30,6 @@ from rover.methods.reply_grammar import (
     leading_percentage,
     lines_of,
     parse_percentage,
-    read_fields,
     split_complete,
     subtask_name,
     tail_percentage,

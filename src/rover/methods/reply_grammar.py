@@ -23,12 +23,12 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 MAX_PARSE_CHARS = 65536  # longer replies are parsed from their first 64 KB only
 MAX_PARSE_LINES = 2000  # ... and their first 2,000 lines (a 240-frame GVL reply has ~1,000)
 _MAX_LABELS = 12  # fields read from one line (a real one-line answer has 2 or 3)
-_MAX_ITEMS = 64  # entries read from one plan (ROVER keeps at most 8 subtasks per line)
+MAX_ITEMS = 64  # entries read from one plan (ROVER keeps at most 8 subtasks per line)
 
 # a number with an optional sign; whitespace bounded so a search never scans ahead
 NUM = r"(?<![\d.,])[-+−–]?[ \t]{0,2}\d{1,12}(?:[.,]\d{1,12})?"
@@ -65,20 +65,7 @@ _COMPLETE = re.compile(
     r"[ \t]+(?:is[ \t]+)?(?:now[ \t]+)?(?:complete|completed|finished|done)\b[.!]*$",
     re.I,
 )
-_QUOTES = "\"'“”‘’`"
-
-
-@dataclass
-class Fields:
-    """What a reply (or one frame's block of it) said, field by field."""
-
-    description: str | None = None
-    progress: float | None = None
-    next_frame: bool = False
-    new_subtask: str | None = None
-    plan: list[str] = field(default_factory=list)
-    task_complete: bool = False
-    loose: list[str] = field(default_factory=list)  # unlabelled text, in order
+QUOTES = "\"'“”‘’`"
 
 
 @dataclass
@@ -198,11 +185,11 @@ def any_percentage(text: str) -> float | None:
 
 def subtask_name(s: str) -> str:
     """A subtask as the model named it: quotes, brackets and trailing prose removed."""
-    s = _NEXT.sub("", s).strip().strip(_QUOTES + "[]{}()").strip()
+    s = _NEXT.sub("", s).strip().strip(QUOTES + "[]{}()").strip()
     m = _SENTENCE_END.search(s)
     if m:
         s = s[: m.start()]
-    return s.strip().rstrip(".").strip().strip(_QUOTES).strip()
+    return s.strip().rstrip(".").strip().strip(QUOTES).strip()
 
 
 def split_list(s: str) -> list[str]:
@@ -219,14 +206,14 @@ def split_list(s: str) -> list[str]:
         end = s.rfind("]")
         s = s[:end] if end >= 0 else s
     s = s.strip()
-    if s and s[0] in _QUOTES:
+    if s and s[0] in QUOTES:
         # items are quote…quote separated by commas: split only at quote-comma-quote
         parts = re.split(
-            rf"[{_QUOTES}][ \t]{{0,3}}[,;][ \t\n]{{0,8}}[{_QUOTES}]", s, maxsplit=_MAX_ITEMS
+            rf"[{QUOTES}][ \t]{{0,3}}[,;][ \t\n]{{0,8}}[{QUOTES}]", s, maxsplit=MAX_ITEMS
         )
     else:
-        parts = re.split(r"[;,]", s, maxsplit=_MAX_ITEMS)
-    parts = parts[:_MAX_ITEMS]
+        parts = re.split(r"[;,]", s, maxsplit=MAX_ITEMS)
+    parts = parts[:MAX_ITEMS]
     return [n for n in (subtask_name(p) for p in parts) if n]
 
 
@@ -285,7 +272,7 @@ def split_complete(desc: str) -> tuple[str, bool]:
 
 
 def is_complete(line: str) -> bool:
-    return bool(_COMPLETE.match(line.strip().strip(_QUOTES)))
+    return bool(_COMPLETE.match(line.strip().strip(QUOTES)))
 
 
 def has_next(line: str) -> tuple[str, bool]:
@@ -294,142 +281,3 @@ def has_next(line: str) -> tuple[str, bool]:
         return line, False
     new = _NEXT.sub("", line)
     return new.strip(), new != line
-
-
-class _Reader:
-    """The state of one pass over a reply's lines (see `read_fields`)."""
-
-    def __init__(self) -> None:
-        self.f = Fields()
-        self.desc: list[str] | None = None  # description lines being collected
-        self.desc_done: list[str] = []  # the first description, once closed
-        self.pending: str | None = None  # a label whose value is on a following line
-        self.items: list[str] | None = None  # plan entries given as a bullet list
-        self.bracket: list[str] | None = None  # a [...] plan spread over lines
-
-    def close(self) -> None:
-        if self.desc is not None and not self.desc_done:
-            self.desc_done = self.desc
-        self.desc = None
-        if self.items is not None:
-            if self.items and not self.f.plan:
-                self.f.plan = self.items
-            self.items = None
-
-    def subtask(self, value: str) -> None:
-        if value.startswith("["):
-            if "]" not in value:
-                self.bracket = [value]
-                return
-            names = split_list(value)
-            self.f.plan = self.f.plan or names
-            value = names[0] if names else ""
-        name = subtask_name(value)
-        if name and self.f.new_subtask is None:
-            self.f.new_subtask = name
-
-    def plan(self, value: str) -> None:
-        if value.startswith("[") and "]" not in value:
-            self.bracket = [value]
-        elif value:
-            self.f.plan = self.f.plan or split_list(value)
-        else:
-            self.items = []
-
-    def field(self, kind: str, value: str, last: bool) -> None:
-        if not value:
-            self.pending = kind
-            if kind == "plan":
-                self.items = []
-            return
-        if kind == "desc":
-            self.close()
-            if last:
-                self.desc = [value]
-            elif not self.desc_done:
-                self.desc_done = [value]
-        elif kind == "pct":
-            if self.f.progress is None:
-                self.f.progress = leading_percentage(value)
-        elif kind in ("needs", "sub"):
-            self.subtask(value)
-        else:
-            self.plan(value)
-
-    def value_line(self, line: Line, s: str) -> None:
-        """The value of a label written alone on the line above (heading style)."""
-        kind, self.pending = self.pending, None
-        if kind in ("needs", "sub", "plan") and line.item:
-            self.items = [subtask_name(s)]
-            if kind != "plan":
-                self.f.new_subtask = self.f.new_subtask or self.items[0]
-        elif kind == "plan":
-            self.items = None
-            self.plan(s)
-        else:
-            self.field(kind or "desc", s, True)
-
-    def line(self, line: Line | None) -> None:
-        if line is None:
-            return
-        s, nxt = has_next(line.text)
-        self.f.next_frame = self.f.next_frame or nxt
-        if self.bracket is not None:
-            self.bracket.append(s)
-            if "]" in s or len(self.bracket) >= _MAX_ITEMS:
-                value, self.bracket = " ".join(self.bracket), None
-                self.f.plan = self.f.plan or split_list(value)
-            return
-        if not s:
-            if self.pending is None and not nxt:
-                self.close()
-            return
-        found = labels(s)
-        if self.items is not None:
-            if line.item and not found:
-                if len(self.items) < _MAX_ITEMS:
-                    self.items.append(subtask_name(s))
-                return
-            if self.pending == "plan" and not found:
-                self.value_line(line, s)
-                return
-            self.pending = None
-            self.close()
-        if not found:
-            if self.pending is not None:
-                self.value_line(line, s)
-            elif is_complete(s):
-                self.f.task_complete = True
-            elif self.desc is not None:
-                self.desc.append(s)
-            else:
-                self.f.loose.append(s)
-            return
-        self.pending = None
-        self.close()
-        if found[0][1] > 0:
-            self.f.loose.append(s[: found[0][1]].strip())
-        for i, (kind, _start, vstart) in enumerate(found):
-            end = found[i + 1][1] if i + 1 < len(found) else len(s)
-            self.field(kind, s[vstart:end].strip(), i + 1 == len(found))
-
-    def finish(self) -> Fields:
-        if self.bracket is not None:
-            self.f.plan = self.f.plan or split_list(" ".join(self.bracket))
-        self.close()
-        f = self.f
-        if self.desc_done:
-            desc, done = split_complete(" ".join(self.desc_done))
-            f.task_complete = f.task_complete or done
-            f.description = desc.strip().strip(_QUOTES).strip() or None
-        if f.new_subtask is None and f.plan:
-            f.new_subtask = f.plan[0]
-        return f
-
-
-def read_fields(lines: list[Line | None]) -> Fields:
-    """One pass over a reply's lines: the fields it states, plus its unlabelled text."""
-    r = _Reader()
-    for line in lines:
-        r.line(line)
-    return r.finish()
