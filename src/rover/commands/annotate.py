@@ -21,6 +21,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from rover.console import make_console
 from rover.errors import InputError
 from rover.methods.registry import method_names
 from rover.vlm import cli_options as vo
@@ -136,11 +137,11 @@ def annotate_command(
         model_path=model_path,
     )
     planned = plan_annotation(opts)
-    console = Console(highlight=False)
+    console = make_console()  # no emoji codes or highlighting guessed in data
     if dry_run:
         _dry_run(opts, planned, console)
         return
-    err = Console(stderr=True, highlight=False)
+    err = make_console(stderr=True)
     bar = Progress(
         TextColumn("[bold]annotate[/]"),
         BarColumn(),
@@ -174,10 +175,10 @@ def annotate_command(
             "[bold yellow]ORACLE[/] output: answers from simulator ground truth, not a VLM",
             soft_wrap=True,
         )
-    console.print(f"frames:   {result.frames_path}", soft_wrap=True)
-    console.print(f"episodes: {result.episodes_path}", soft_wrap=True)
+    console.print(f"frames:   {escape(str(result.frames_path))}", soft_wrap=True)
+    console.print(f"episodes: {escape(str(result.episodes_path))}", soft_wrap=True)
     if result.in_place_path is not None:
-        console.print(f"in place: {result.in_place_path}", soft_wrap=True)
+        console.print(f"in place: {escape(str(result.in_place_path))}", soft_wrap=True)
     if result.failed:
         first = next(iter(result.failed.items()))
         err.print(

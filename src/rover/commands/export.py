@@ -13,8 +13,8 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 
+from rover.console import esc, make_console
 from rover.errors import InputError
 
 FORMATS = ("lerobot",)
@@ -50,9 +50,9 @@ def export_command(
         raise InputError(f"{dataset}: no such dataset directory")
     info = export_lerobot(dataset, out, fps=fps)
     cameras = [k for k, f in info["features"].items() if f["dtype"] == "video"]
-    Console(highlight=False).print(
+    make_console().print(
         f"exported {info['total_episodes']} episodes ({info['total_frames']} frames, "
         f"{len(cameras)} cameras, {info['fps']} fps) as LeRobot {info['codebase_version']} "
-        f"to {out}",
+        f"to {esc(out)}",
         soft_wrap=True,
     )
