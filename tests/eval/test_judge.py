@@ -81,6 +81,9 @@ def test_judge_prompt_carries_description_and_facts() -> None:
         pressed=["button"],
     )
     text = facts_to_text(facts)
+    assert "Other parts of the robot" not in text
+    arm = facts_to_text(facts.model_copy(update={"robot_contacts": ["can", "table"]}))
+    assert "Other parts of the robot (not the gripper) touch: table." in arm
     for s in (
         "The gripper is closed.",
         "holding the can",

@@ -67,6 +67,9 @@ def facts_to_text(facts: FrameFacts) -> str:
         lines.append(f"- The gripper is touching: {', '.join(facts.contacts)}.")
     else:
         lines.append("- The gripper is not touching anything.")
+    others = [o for o in getattr(facts, "robot_contacts", []) if o not in facts.contacts]
+    if others:
+        lines.append(f"- Other parts of the robot (not the gripper) touch: {', '.join(others)}.")
     for name, obj in facts.objects.items():
         parts = ["lifted" if obj.lifted else "not lifted"]
         if obj.inside:
