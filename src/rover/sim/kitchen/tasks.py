@@ -57,6 +57,7 @@ def _move(name: str, obj: str, point: str, goal: str, signal: str) -> SubtaskSpe
         robot_points=FINGERS,
         object_points=[point, point],
         goal=goal,
+        joint=f"joint:{obj}",  # progress follows the part's joint toward its target
         beta=0.8,
         end_signal=signal,
     )
@@ -104,6 +105,12 @@ def _drawer(closing: bool) -> TaskSpec:
                 f"Finish {ing} the drawer",
             ],
         ),
+        milestones=[
+            "approach:drawer",
+            "contact:drawer",
+            f"{verb}_start:drawer",
+            f"{verb}_finish:drawer",
+        ],
         qa_templates=_qa(
             "drawer",
             [
@@ -147,6 +154,7 @@ OPEN_SINGLE_DOOR = _spec(
             "Finish opening the door",
         ],
     ),
+    milestones=["approach:door", "contact:door", "open_start:door", "open_finish:door"],
     qa_templates=_qa(
         "door",
         [
@@ -194,6 +202,7 @@ def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
                 f"Press the button and turn the {appliance} on",
             ],
         ),
+        milestones=["approach:button", "press:button"],
         qa_templates=_qa(
             "button",
             [
@@ -252,6 +261,7 @@ def _dial(
                 f"Finish turning the {part_words}",
             ],
         ),
+        milestones=["approach:knob", "contact:knob", "turn_start:knob", "turn_finish:knob"],
         qa_templates=_qa(
             "knob",
             [
