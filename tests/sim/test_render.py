@@ -42,3 +42,23 @@ def test_unknown_view_lists_valid_ones():
 
     with pytest.raises(InputError, match="valid views: wrist, left, right"):
         check_views(["left", "top"])
+
+
+def test_left_and_right_views_see_gripper_objects_and_goals_of_every_task(sim_env):
+    """Projected into the free views aimed by `view_centre`, the gripper, every task object
+    and every goal point lie inside the frame at the start of each task."""
+    from rover.sim.render import in_view, view_centre
+    from rover.sim.tasks import get_task, task_names
+
+    for name in task_names():
+        spec = get_task(name)
+        sim = sim_env(name)
+        sim.reset(0)
+        centre = view_centre(sim)
+        pts = {"gripper": sim.point("eef")}
+        pts.update({o.name: sim.point(o.name) for o in spec.objects})
+        pts.update({s.goal: sim.point(s.goal) for s in spec.subtasks if s.goal})
+        for view in ("left", "right"):
+            for what, p in pts.items():
+                assert in_view(view, centre, p), f"{name}: {what} is outside the {view} view"
+            assert not in_view(view, centre, centre + [0.0, 0.0, 3.0])  # far overhead: not

@@ -20,7 +20,8 @@ from rover.sim.milestones import level_problems
 from rover.sim.tasks.base import TaskSpec
 
 MAX_TRIES = 12  # tries per episode before the best one is kept (and flagged)
-ENDINGS = 4  # final deviations drawn per planned prefix
+ENDINGS = 6  # final deviations drawn per planned prefix
+FLOOR_TOLERANCE = 0.05  # a level may end this far below the previous level's cut
 TRY_STRIDE = 1_000_003  # plan index offset between attempts (independent Generators)
 RECOVERY_GAP = 0.015  # m an object may sit off the expert state a recovery hands over to
 HIGHEST_MIN_END = 0.95  # the top level must (almost) finish the task
@@ -146,6 +147,7 @@ def make_attempts(
     names = required_points(spec.subtasks)
     signals = [s.end_signal for s in spec.subtasks]
     top = max(lv.level for lv in spec.levels)
+    below = next((lv for lv in spec.levels if lv.level == level.level - 1), None)
     tries = 0
     plan_no = 0
     while tries < MAX_TRIES:
@@ -163,6 +165,7 @@ def make_attempts(
         prefix = execute_plan(sim, states, actions, head, act_rng)
         if d not in expert_tracks:
             expert_tracks[d] = point_tracks(sim, states, names)
+        floor = _floor(below, expert_tracks[d], spec, bounds, int(ends[-1]), form)
         pre_tracks = point_tracks(sim, prefix.states, names, signals)
         endings = ENDINGS if terminal is not None else 1
         for e in range(endings):
@@ -200,8 +203,31 @@ def make_attempts(
                     f"a recovery leaves an object {roll.recovery_gap * 100:.1f} cm off the "
                     "expert state it hands over to (it would jump)"
                 )
+            if terminal is not None and prog[-1] < floor:
+                problems.append(
+                    f"ends at progress {prog[-1]:.2f}, below where the level under it stops "
+                    f"({floor + FLOOR_TOLERANCE:.2f})"
+                )
             if level.level == top and prog[-1] < HIGHEST_MIN_END:
                 problems.append(f"top level ends at progress {prog[-1]:.2f} < {HIGHEST_MIN_END}")
             yield Attempt(tries, d, roll, prog, pos, facts, events, problems)
             if roll.recovery_gap > RECOVERY_GAP or tries >= MAX_TRIES:
                 break  # the prefix itself is at fault: plan again
+
+
+def _floor(below, expert, spec: TaskSpec, bounds, goal_end: int, form: str) -> float:
+    """The expert's progress where the level below stops (its cut point's middle), less
+    `FLOOR_TOLERANCE`: a level's video must end at least that far along, so the final
+    progress rises with the level (0 when there is no terminating level below)."""
+    from rover.sim.value import progress_from_tracks
+
+    if below is None or below.terminate_subtask is None:
+        return 0.0
+    k = min(below.terminate_subtask, len(bounds) - 1)
+    a, b = bounds[k]
+    cut = a + int(round(sum(below.terminate_at) / 2 * (b - a)))
+    steps = np.arange(len(expert))
+    prog = progress_from_tracks(
+        expert, steps, expert, spec.subtasks, bounds, goal_end=goal_end, form=form
+    )
+    return max(float(prog[cut]) - FLOOR_TOLERANCE, 0.0)

@@ -166,7 +166,7 @@ def facts_for_states(
     prev_hand: dict[str, np.ndarray] | None = None
     held: str | None = None
     for t, s in enumerate(states):
-        if previous is not None and t > 0:
+        if previous is not None:
             sim.set_state(previous[t])
             prev_hand = hand_positions(sim)
         sim.set_state(s)

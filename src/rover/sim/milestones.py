@@ -51,7 +51,20 @@ def achieved(component: str, facts: Sequence[FrameFacts], events: Sequence[Event
             and o.goal_distance <= APPROACH_GOAL
             for f in facts
         )
+    if kind == "place":  # placed, or let fall and come to rest in its goal all the same
+        return any(_in_goal(f, obj) for f in facts) or _event(kind, obj, events)
+    return _event(kind, obj, events)
+
+
+def _event(kind: str, obj: str, events: Sequence[Event]) -> bool:
     return any(e.name == kind and e.object == obj and e.frame is not None for e in events)
+
+
+def _in_goal(f: FrameFacts, obj: str) -> bool:
+    o = f.objects.get(obj)
+    if o is None or f.holding == obj:
+        return False
+    return o.inside not in (None, "start bin") or o.on not in (None, "table")
 
 
 def level_problems(

@@ -126,6 +126,24 @@ class StateRenderer:
         self.renderer.close()
 
 
+def in_view(view: str, lookat: np.ndarray, point: np.ndarray, fovy: float = 45.0) -> bool:
+    """Whether a world point falls inside a square frame of free view `view` aimed at
+    `lookat` (pinhole projection with MuJoCo's free-camera geometry and vertical fovy)."""
+    fv = FREE_VIEWS[view]
+    az, el = np.radians(fv.azimuth), np.radians(fv.elevation)
+    fwd = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    pos = np.asarray(lookat, dtype=np.float64) - fv.distance * fwd
+    right = np.cross(fwd, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    v = np.asarray(point, dtype=np.float64) - pos
+    depth = float(v @ fwd)
+    if depth <= 0:
+        return False
+    half = np.tan(np.radians(fovy) / 2)
+    return abs(v @ right) / depth < half and abs(v @ up) / depth < half
+
+
 def view_centre(sim) -> np.ndarray:
     """Where the free views look for a task: the middle of the gripper, the task objects
     and their goals in the simulator's current state (an episode's first state)."""
