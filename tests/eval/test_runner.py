@@ -113,7 +113,7 @@ def test_failing_episode_is_recorded_and_the_run_goes_on(tmp_path: Path, make_da
     video.write_bytes(b"\x00not an mp4" * 50)
     out = tmp_path / "run"
     res = _eval("--dataset", str(ds), "--methods", "temporal-concat", "--out", str(out))
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 1, res.output  # a run with failed units is not a success
     m = _metrics(out)
     assert m["counts"] == {**m["counts"], "traces": 2, "failed": 1}
     errors = [json.loads(x) for x in (out / "errors.jsonl").read_text().splitlines()]
@@ -279,13 +279,13 @@ def test_resume_after_judge_failures_needs_no_video(tmp_path: Path, make_dataset
         "--out",
         str(out),
     ]
-    assert _eval(*args).exit_code == 0
+    assert _eval(*args).exit_code == 1  # judge failures are failed units: not a success
     errors = [json.loads(x) for x in (out / "errors.jsonl").read_text().splitlines()]
     assert [e["stage"] for e in errors] == ["judge", "judge"]
     traces = {p: p.read_bytes() for p in (out / "traces").rglob("*.json")}
     for video in ds.rglob("*.mp4"):
         video.unlink()  # a resume with only judging left must not need pixels
-    assert _eval(*args, "--resume").exit_code == 0
+    assert _eval(*args, "--resume").exit_code == 1
     errors = [json.loads(x) for x in (out / "errors.jsonl").read_text().splitlines()]
     assert [e["stage"] for e in errors] == ["judge", "judge"]  # not "load"
     assert {p: p.read_bytes() for p in (out / "traces").rglob("*.json")} == traces

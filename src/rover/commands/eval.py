@@ -9,7 +9,13 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import (
+    BarColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
 from rich.table import Table
 
 from rover.console import esc, line, make_console
@@ -194,13 +200,15 @@ def eval_command(
         command=["rover"] + sys.argv[1:],
     )
     err = make_console(stderr=True)
+    # one line that fits 80 columns; the bar and ETA follow work units, and calls / tokens
+    # move with every VLM call (a ROVER episode against a real API is ~40 calls)
     progress = Progress(
         TextColumn("[bold]eval[/]"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TextColumn("episodes"),
+        BarColumn(bar_width=12),
         TextColumn("{task.fields[info]}"),
         TimeElapsedColumn(),
+        TextColumn("eta"),
+        TimeRemainingColumn(),
         console=err,
         transient=False,
     )
@@ -208,11 +216,15 @@ def eval_command(
 
     def on_update(state) -> None:
         info = (
-            f"units {state.units_done}/{state.units_total}  calls {state.calls:,}  "
-            f"tokens {state.tokens:,}  errors {state.errors}"
+            f"ep {state.episodes_done}/{state.episodes_total} calls {state.calls:,} "
+            f"tok {_short(state.tokens)} err {state.errors}"
         )
+        # units skipped on --resume are not work done now: leave them out of the ETA's rate
         progress.update(
-            task_id, total=state.episodes_total, completed=state.episodes_done, info=info
+            task_id,
+            total=max(1, state.units_total - state.units_skipped),
+            completed=state.units_done - state.units_skipped,
+            info=info,
         )
 
     runner = prepare_run(opts, on_update)
@@ -236,34 +248,47 @@ def eval_command(
 
 _SHORT_HEADERS = {
     "Pearson r": "r",
-    "Error rate": "err",
-    "Success rate": "succ",
-    "QA acc.": "QA",
+    "Error rate %": "err%",
+    "Success rate %": "succ%",
+    "QA acc. %": "QA%",
     "Tokens/video": "tokens",
     "Calls/video": "calls",
 }
 
 
 def _print_main_table(metrics: dict, oracle: bool = False) -> None:
+    """summary.md's main table without SE, in 80 columns: no vertical rules, short headers,
+    numbers never cut (a long method name wraps instead); n goes into the title."""
+    from rich import box
+
     from rover.eval.summary import main_rows
 
     headers, rows = main_rows(metrics, compact=True)
-    title = "rover eval: mean over videos (± SE in summary.md)"
+    n = sorted({r[-1] for r in rows})
+    title = f"rover eval: mean over {'/'.join(n) or 0} videos per method (± SE: summary.md)"
     if oracle:
         title += "\nORACLE OUTPUT: oracle rows answer from ground truth, not a VLM"
-    table = Table(title=title)
-    for h in headers:
-        # numbers never fold (short headers keep them narrow); long method names wrap
-        is_name = h == "Method"
+    table = Table(title=title, box=box.SIMPLE_HEAD, padding=(0, 1), pad_edge=False)
+    for h in headers[:-1]:
+        is_name = h in ("Method", "View")
         table.add_column(
             _SHORT_HEADERS.get(h, h),
             no_wrap=not is_name,
             overflow="fold" if is_name else "ellipsis",
             justify="left" if is_name else "right",
+            min_width=6 if is_name else None,
         )
     for r in rows:
-        table.add_row(*(esc(cell) for cell in r))  # method and backend names are data
+        table.add_row(*(esc(cell) for cell in r[:-1]))  # method and backend names are data
     make_console().print(table)
+
+
+def _short(n: int) -> str:
+    """1234 -> '1.2k', 3400000 -> '3.4M' (the live line only; results print in full)."""
+    for unit, size in (("M", 1_000_000), ("k", 1_000)):
+        if n >= size:
+            return f"{n / size:.1f}{unit}"
+    return str(n)
 
 
 def _build_report(run_dir: Path, err: Console) -> None:

@@ -44,8 +44,10 @@ def cost_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     out = []
     ok = [r for r in rows if not r.get("error")]
     for metric in ("total_tokens", "calls", "prompt_tokens", "completion_tokens"):
-        stats = group_mean_se(ok, metric, lambda r: (r["variant"], r["method"], r["n_frames"]))
-        for (variant, method, n_frames), (mean, se, n) in sorted(stats.items()):
+        stats = group_mean_se(ok, metric, lambda r: (r["variant"], r["method"], _frames(r)))
+        for (variant, method, n_frames), (mean, se, n) in sorted(
+            stats.items(), key=lambda kv: tuple(map(str, kv[0]))
+        ):
             out.append(
                 {
                     "variant": variant,
@@ -58,3 +60,11 @@ def cost_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 }
             )
     return out
+
+
+def _frames(row: dict[str, Any]) -> int | str:
+    """The frame-count setting a row ran at ('all': each video's own length, which varies
+    on real data), or the video's frame count for rows that do not say."""
+    if "frames_setting" in row:
+        return row["frames_setting"] or "all"
+    return row["n_frames"]

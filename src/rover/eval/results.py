@@ -130,6 +130,7 @@ def compute_metrics(rundir: RunDir, config: dict[str, Any]) -> dict[str, Any]:
                 "method": v.method,
                 "backend": v.backend,
                 "window": v.window,
+                "frames_setting": v.frames,
                 "dataset": datasets.get(eid),
             }
             trace = _load(rundir.trace_path(eid, v.id), Trace)
@@ -215,15 +216,14 @@ INCONCLUSIVE_WARN = 30.0  # % of a method's judged frames
 
 def _notes(rows: list[dict[str, Any]], frame_rows: list[dict[str, Any]]) -> list[str]:
     """One line per analysis that does not apply to this run, saying why (never zeros)."""
-    ok = [r for r in rows if r.get("error") is None]
+    ok = [_clean(r) for r in rows if r.get("error") is None]  # NaN -> None
     notes = []
-    judged = [r for r in ok if r.get("n_judged") is not None]
     if ok and not any(r.get("error_rate") is not None for r in ok):
-        if judged or any(r.get("n_judged") == 0 for r in ok):
+        if any(r.get("n_judged") is not None for r in ok):  # judged, but nothing to judge by
             notes.append(
-                "Frame reasoning (Task 2, error / success rate, error rate by state type and "
-                "frames in context) is omitted: no video in this run has simulator facts to "
-                "judge descriptions against."
+                "Frame reasoning (Task 2: error / success rate, by state type and frames in "
+                "context) and the perception row of the error analysis are omitted: no video "
+                "in this run has simulator facts to judge descriptions against."
             )
     frame_truth = [r for r in ok if r.get("progress_source") == "frame_number"]
     if frame_truth:

@@ -31,6 +31,7 @@ from rover.eval.episodes import (
     variant_episode,
 )
 from rover.eval.judge import llm_judge_trace, rule_judge_trace
+from rover.eval.live import Counted
 from rover.eval.qa import llm_answer_trace, rule_answer_trace
 from rover.eval.runconfig import run_config
 from rover.eval.rundir import RunDir, write_json_atomic
@@ -170,6 +171,17 @@ class Runner:
         }
         self.judge_vlm = self._aux(opts.judge)
         self.answer_vlm = self._aux(opts.answerer)
+        # every finished call counts at once (the display moves during long episodes)
+        self.vlms = {b: Counted(v, self._count_call) for b, v in self.vlms.items()}
+        if self.judge_vlm is not None:
+            self.judge_vlm = Counted(self.judge_vlm, self._count_call)
+        if self.answer_vlm is not None:
+            self.answer_vlm = Counted(self.answer_vlm, self._count_call)
+
+    def _count_call(self, tokens: int) -> None:
+        self.state.calls += 1
+        self.state.tokens += tokens
+        self.on_update(self.state)
 
     def _aux(self, spec: str) -> Any:
         if spec.lower() in OFF or spec.lower() == "rule":
@@ -304,8 +316,6 @@ class Runner:
             trace.totals = trace.compute_totals()
         await asyncio.to_thread(trace.save, path)
         self.rundir.log_unit(ref.id, v.id, "trace", "done", calls=trace.totals.calls)
-        self.state.calls += trace.totals.calls
-        self.state.tokens += trace.totals.total_tokens
         return trace
 
     async def _judge(self, ref: EpisodeRef, episode: Episode, trace: Trace, v: Variant) -> None:
@@ -357,8 +367,6 @@ class Runner:
             write_json_atomic, self.rundir.stage_path(stage, ref.id, v.id), result
         )
         self.rundir.log_unit(ref.id, v.id, stage, "done", calls=result.calls)
-        self.state.calls += result.calls
-        self.state.tokens += result.total_tokens
 
 
 def method_params(opts: EvalOptions) -> dict[str, dict[str, Any]]:

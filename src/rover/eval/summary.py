@@ -148,6 +148,8 @@ def pivot(
     aggs = [a for a in metrics.get("aggregates", []) if a["by"] == by and a["metric"] == metric]
     if not any(a["mean"] is not None for a in aggs):
         return None  # nothing measured: omitted (metrics.json notes say why), never zeros
+    if {str(a["group"]) for a in aggs} <= {"unknown", "None"}:
+        return None  # one unlabelled group (real videos have no task group): no breakdown
     variants = [
         v for v in metrics.get("variants", []) if any(a["variant"] == v["id"] for a in aggs)
     ]
@@ -362,8 +364,8 @@ def _cost_table(metrics: dict[str, Any]) -> Table | None:
 
 def _error_table(metrics: dict[str, Any]) -> Table | None:
     rows = metrics.get("error_analysis", [])
-    if not rows:
-        return None
+    if not any(r["mean"] is not None for r in rows):
+        return None  # no rule applies to any video (metrics.json notes say why)
     variants = list(dict.fromkeys(r["variant"] for r in rows))
     labels = variant_names(metrics)
     names = {
