@@ -1,10 +1,12 @@
 """Reasoning methods: ROVER, its ablations and the baselines, each Episode + VLM -> Trace.
 
 Prompt kinds (`PromptMeta.kind`) used here, which the oracle backend answers:
-"rover.step" (one ROVER step on a window of frames), "rover.parent" (the text-only
-parent turn after a child line returns), "gvl.batch" (shuffled frames with a 0% anchor),
-"concat.frame" (ordered frames, answer for the last one) and "concat.video" (every frame).
-A re-ask with a format reminder keeps the kind and sets `meta.extra["reminder"] = True`.
+"rover.step" (one ROVER step on a window of frames), "rover.parent" (the parent turn
+after a child line returns, showing the child's final frame), "gvl.batch" (shuffled frames
+with a 0% anchor), "concat.frame" (ordered frames, answer for the last one) and
+"concat.video" (every frame). A re-ask with a format reminder keeps the kind and sets
+`meta.extra["reminder"] = True` (and `meta.extra["missing"]`, the frame labels a cut-off
+reply did not reach).
 """
 
 from rover.methods.base import Method, StepInfo

@@ -8,7 +8,7 @@ Algorithm 1, as implemented by `Rover._line` (comments cite its line numbers):
     4      if Y progresses to next frame         "Subtask completion percentage: N%" [next-frame]
     5        Y = Y + o_next                      Y = Window(Y + o_next)
     6      elif Y specifies a new task           "The robot needs to: <subtask>"
-    7        Y = Y + ψ(ROVER(φ(Y), []))          child line; then a text-only parent turn
+    7        Y = Y + ψ(ROVER(φ(Y), []))          child line; then the parent turn (ψ)
     8      elif Y indicates task complete        ≥ threshold, "Task complete", or end of video
     9        return Y
 
