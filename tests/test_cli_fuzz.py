@@ -180,7 +180,7 @@ def _reason_cases() -> list[Case]:
         c.append(Case(f"reason: --frames {value}", [*R, *ORACLE, "--frames", value], "--frames"))
     for value in ("0", "-5", "100000", "abc"):
         c.append(Case(f"reason: --size {value}", [*R, *ORACLE, "--size", value], "--size"))
-    for value in ("bogus", "", "ROVER"):
+    for value in ("bogus", "", "ROVER", "[/]", "[link=http://x]m"):
         c.append(Case(f"reason: --method {value!r}", [*R, *ORACLE, "--method", value], "method"))
     for value in ("0", "-1", "abc"):
         c.append(Case(f"reason: --window {value}", [*R, *ORACLE, "--window", value], "window"))
@@ -200,6 +200,8 @@ def _reason_cases() -> list[Case]:
         ("replay:{t}/malformed.jsonl", "malformed"),
         ("replay:{t}/a_file", "no recorded completions"),
         ("openai:m@http://u:{pw}@127.0.0.1:9/v1", "cannot connect"),
+        ("openai:smile:@http://127.0.0.1:9/v1", "openai:smile:"),  # printed, not an emoji
+        ("openai:[/]@http://127.0.0.1:9/v1", "openai:[/]"),
     ]
     for spec, names in backends:
         argv = [*R, "--backend", spec, "--max-retries", "1", *out]
