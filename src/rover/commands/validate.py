@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 from typing import Annotated
 
@@ -12,6 +13,12 @@ from rover.console import esc
 from rover.errors import InputError
 
 SHOW_PROBLEMS = 20  # problems listed after the table (all of them with --all)
+LEGEND = (
+    "milestone: episodes showing their level's milestone and not the next; events: "
+    "episodes whose events agree with the facts; teleports: episodes where an untouched "
+    "object rises > 2 cm between frames; final progress: mean per level (must not fall); "
+    "stalls: episodes with > 3 still expert frames in a row; tries: mean/max per episode"
+)
 
 
 def audit_table(audits) -> Table:
@@ -19,16 +26,16 @@ def audit_table(audits) -> Table:
     table = Table(title="ground-truth audit", title_justify="left")
     for col, just in (
         ("task", "left"),
-        ("episodes", "right"),
-        ("milestones met", "right"),
-        ("events = facts", "right"),
-        ("untouched moved", "right"),
-        ("final progress by level", "left"),
-        ("expert stalls", "right"),
-        ("tries (mean/max)", "right"),
+        ("eps", "right"),
+        ("milestone", "right"),
+        ("events", "right"),
+        ("teleports", "right"),
+        ("final progress L1..Ln", "left"),
+        ("stalls", "right"),
+        ("tries", "right"),
         ("ok", "left"),
     ):
-        table.add_column(col, justify=just)  # type: ignore[arg-type]
+        table.add_column(col, justify=just, no_wrap=True)  # type: ignore[arg-type]
     for a in audits:
         means = " ".join(f"{m:.2f}" for m in a.level_means().values())
         order = "" if a.ordered() else " (falls)"
@@ -57,6 +64,7 @@ def run_audit(root: Path, console, show_all: bool = False) -> int:
         raise InputError(f"{root}: the dataset has no episodes")
     audits = audit(episodes)
     console.print(audit_table(audits))
+    console.print(LEGEND)
     problems = [p for a in audits for p in a.problems]
     shown = problems if show_all else problems[:SHOW_PROBLEMS]
     for p in shown:
@@ -85,7 +93,8 @@ def validate_command(
         root = bundled_dataset_path()
     if not (root / "dataset.json").exists():
         raise InputError(f"{dataset}: not a rover dataset directory (no dataset.json)")
-    if run_audit(root, make_console()) > 0:
+    wide = max(shutil.get_terminal_size((140, 24)).columns, 140)  # the table needs ~130
+    if run_audit(root, make_console(width=wide)) > 0:
         raise typer.Exit(1)
 
 
