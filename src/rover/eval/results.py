@@ -241,26 +241,22 @@ def _notes(rows: list[dict[str, Any]], frame_rows: list[dict[str, Any]]) -> list
 
 
 def judge_facts(config: dict[str, Any]) -> dict[str, Any]:
-    """Which judge and answerer scored the run, with their measured agreement if known."""
+    """Which judge and answerer scored the run, with their measured agreement
+    (rover.eval.judge_cards) so every view can print it beside their numbers."""
     out: dict[str, Any] = {"judge": config.get("judge"), "answerer": config.get("answerer")}
     try:
-        from rover.eval import judge_cards  # written by the judge work; optional
-    except ImportError:
+        from rover.eval.judge_cards import judge_card
+    except ImportError:  # pragma: no cover - the cards ship with rover
         return out
     for role in ("judge", "answerer"):
-        name = out[role]
-        card = None
-        for fn in ("agreement", "card", "judge_card", f"{role}_card"):
-            f = getattr(judge_cards, fn, None)
-            if callable(f):
-                try:
-                    card = f(name)
-                except Exception:  # noqa: BLE001 - the card is extra information only
-                    card = None
-                if card is not None:
-                    break
+        try:
+            card = judge_card(role, str(out[role] or ""))
+        except Exception:  # noqa: BLE001 - the card is extra information only
+            card = None
         if card is not None:
-            out[f"{role}_agreement"] = card if isinstance(card, int | float | str) else str(card)
+            out[f"{role}_name"] = card.name
+            out[f"{role}_agreement"] = card.short()
+            out[f"{role}_line"] = card.line()
     return out
 
 
@@ -391,6 +387,7 @@ def _counts(rows: list[dict[str, Any]]) -> dict[str, Any]:
             r.get("pearson") is not None and math.isnan(r["pearson"]) for r in ok
         ),
         "parse_failures": sum(int(r.get("parse_failures") or 0) for r in ok),
+        "truncated_replies": sum(int(r.get("truncated") or 0) for r in ok),
     }
 
 

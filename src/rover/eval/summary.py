@@ -395,7 +395,7 @@ def _error_table(metrics: dict[str, Any]) -> Table | None:
 
 def _judge_line(metrics: dict[str, Any], run: dict[str, Any], role: str) -> str:
     facts = metrics.get("judges", {})
-    name = facts.get(role) or run.get(role)
+    name = facts.get(f"{role}_name") or facts.get(role) or run.get(role)
     agree = facts.get(f"{role}_agreement")
     return f"{name} (measured agreement: {agree})" if agree is not None else str(name)
 
@@ -410,6 +410,7 @@ def _counts_section(metrics: dict[str, Any]) -> list[str]:
         f"- constant predictions (VOC and Pearson scored 0): {c.get('voc_constant', 0)}",
         f"- Pearson undefined (constant ground truth, left out): {c.get('pearson_undefined', 0)}",
         f"- parse failures in traces: {c.get('parse_failures', 0)}",
+        f"- truncated replies (stopped at max_tokens): {c.get('truncated_replies', 0)}",
         "",
     ]
     failed = [

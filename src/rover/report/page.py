@@ -87,7 +87,7 @@ def render_page(
 
 def _judge(run: RunData, role: str) -> str:
     facts = run.metrics.get("judges", {})
-    name = facts.get(role) or run.config.get(role) or "—"
+    name = facts.get(f"{role}_name") or facts.get(role) or run.config.get(role) or "—"
     agree = facts.get(f"{role}_agreement")
     return f"{name} (measured agreement: {agree})" if agree is not None else str(name)
 
