@@ -63,7 +63,12 @@ def test_events_agree_with_facts():
     assert event_problems(Event(name="grasp", object="can", frame=None), facts) == []
     assert event_problems(Event(name="grasp", object="can", frame=7), facts)
     lifted = FrameFacts(objects={"can": ObjectFacts(lifted=True)})
-    assert event_problems(Event(name="pick_up", object="can", frame=0), [lifted]) == []
+    carried = FrameFacts(holding="can", objects={"can": ObjectFacts(lifted=True)})
+    assert event_problems(Event(name="pick_up", object="can", frame=0), [carried]) == []
+    assert event_problems(Event(name="pick_up", object="can", frame=0), [lifted])  # not held
+    # a grasp is a hold beginning; a drop and a place end one
+    assert event_problems(Event(name="grasp", object="can", frame=2), [free, held, held])
+    assert event_problems(Event(name="drop", object="can", frame=2), [free, free, free])
     placed = FrameFacts(objects={"can": ObjectFacts(inside="bin 2")})
     assert event_problems(Event(name="place", object="can", frame=0), [placed]) == []
     loose = FrameFacts(objects={"can": ObjectFacts()})

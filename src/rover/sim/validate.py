@@ -54,7 +54,10 @@ EVENT_RULES: dict[str, tuple[Callable[[FrameFacts, str], bool], str]] = {
     "contact": (_holds_or_touches, "the gripper does not touch it"),
     "grasp": (_held, "it is not held"),
     "pick_up": (lambda f, o: _held(f, o) and _lifted(f, o), "it is not held off its start"),
-    "drop": (lambda f, o: f.holding != o and not _placed(f, o), "it is held or in its goal"),
+    "drop": (
+        lambda f, o: f.holding != o and not (o in f.objects and _placed(f, o)),
+        "it is held or in its goal",
+    ),
     "place": (_placed, "it is held, or neither inside nor on its goal"),
     "press": (_pressed, "it is not pressed"),
     "open_start": (_opening, "its opening is 0"),

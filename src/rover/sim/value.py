@@ -351,7 +351,7 @@ def progress_from_tracks(
     sub_idx = np.minimum(np.searchsorted(ends, q, side="left"), len(ends) - 1)
     if rover:
         q, sub_idx = _undo(tracks, q, sub_idx, subtasks, bounds)
-        last_kept = tracks.kept.get(subtasks[-1].end_signal)
+        last_kept = tracks.kept.get(getattr(subtasks[-1], "end_signal", ""))
         if last_kept is not None:
             after_goal &= last_kept
         after_goal &= sub_idx == len(bounds) - 1
