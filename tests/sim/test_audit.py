@@ -89,3 +89,13 @@ def test_audit_counts_per_task_and_flags_falling_level_order():
     assert a.task == "Lift" and a.episodes == 2 and a.tries[1] == [2]
     assert not a.ordered() and any("falls with level" in p for p in a.problems)
     assert a.milestones_met == 1  # level 1 holds; level 2 never approaches the cube
+
+
+def test_every_task_lists_one_component_per_level_step():
+    from rover.sim.tasks import get_task, task_names
+
+    for name in task_names():
+        spec = get_task(name)
+        assert len(spec.milestones) == len(spec.levels) - 1, name
+        objects = {o.name for o in spec.objects}
+        assert all(c.partition(":")[2] in objects for c in spec.milestones), name
