@@ -70,9 +70,10 @@ def test_events_agree_with_facts():
     assert event_problems(Event(name="grasp", object="can", frame=2), [free, held, held])
     assert event_problems(Event(name="drop", object="can", frame=2), [free, free, free])
     placed = FrameFacts(objects={"can": ObjectFacts(inside="bin 2")})
-    assert event_problems(Event(name="place", object="can", frame=0), [placed]) == []
+    assert event_problems(Event(name="place", object="can", frame=1), [held, placed]) == []
+    assert event_problems(Event(name="place", object="can", frame=0), [placed])  # no hold
     loose = FrameFacts(objects={"can": ObjectFacts()})
-    assert event_problems(Event(name="place", object="can", frame=0), [loose])
+    assert event_problems(Event(name="place", object="can", frame=1), [held, loose])
     door = FrameFacts(articulations={"door": 0.4})
     assert event_problems(Event(name="open_start", object="door", frame=0), [door]) == []
     assert event_problems(Event(name="press", object="button", frame=0), [FrameFacts()])

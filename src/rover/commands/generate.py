@@ -111,7 +111,8 @@ def generate_command(
     console.print(f"wrote {len(written)} episodes to {esc(out)} in {took:.1f}s")
     from rover.commands.validate import run_audit
 
-    if run_audit(out, console) > 0:  # the same audit as `rover validate OUT`
+    wide = make_console(stderr=True, width=max(console.width, 140))
+    if run_audit(out, wide) > 0:  # the same audit as `rover validate OUT`
         raise typer.Exit(1)
 
 

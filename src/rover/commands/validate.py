@@ -94,7 +94,7 @@ def validate_command(
     if not (root / "dataset.json").exists():
         raise InputError(f"{dataset}: not a rover dataset directory (no dataset.json)")
     wide = max(shutil.get_terminal_size((140, 24)).columns, 140)  # the table needs ~130
-    if run_audit(root, make_console(width=wide)) > 0:
+    if run_audit(root, make_console(width=wide), show_all) > 0:
         raise typer.Exit(1)
 
 

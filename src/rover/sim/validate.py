@@ -78,6 +78,8 @@ def event_problems(event: Event, facts: list[FrameFacts]) -> list[str]:
     if not check(facts[event.frame], event.object):
         return [f"event {event.name} {event.object!r} at frame {event.frame}, but {why} there"]
     begins = HOLD_CHANGE.get(event.name)
+    if begins is False and event.frame == 0:
+        return [f"event {event.name} {event.object!r} at frame 0 ends a hold no frame shows"]
     if begins is not None and event.frame > 0:
         before = _held(facts[event.frame - 1], event.object)
         if before == begins:
