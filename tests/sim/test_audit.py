@@ -25,6 +25,7 @@ def _f(reach=0.3, held=False, lifted=False, goal=0.4, z=0.82, contacts=(), eef=(
 def test_components_from_facts_and_events():
     far, near = _f(reach=0.3), _f(reach=0.05)
     assert not achieved("approach:can", [far], []) and achieved("approach:can", [far, near], [])
+    assert not achieved("approach:can", [_f(reach=0.08), _f(reach=0.06)], [])  # barely moved
     carry = [_f(held=True, lifted=True)] * 4
     assert achieved("carry:can", carry, []) and not achieved("carry:can", carry[:3], [])
     over = _f(held=True, lifted=True, goal=0.05)
@@ -35,7 +36,7 @@ def test_components_from_facts_and_events():
 
 
 def test_level_needs_its_components_and_not_the_next():
-    touched = [_f(reach=0.05)]
+    touched = [_f(reach=0.3), _f(reach=0.05)]
     contact = [Event(name="contact", object="can", frame=0)]
     assert level_problems(2, COMPONENTS, touched, []) == []  # approached, no contact
     assert any("must stop before" in p for p in level_problems(2, COMPONENTS, touched, contact))

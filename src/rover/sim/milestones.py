@@ -5,7 +5,8 @@ pick it up, keep the grasp while carrying it, bring it over its target, place it
 L of a task means: components 1..L-1 achieved, component L not (the top level achieves
 all of them). Each component is ``"<kind>:<object>"``:
 
-* ``approach``: the gripper comes within `APPROACH` of the point the object is taken by;
+* ``approach``: the gripper comes within `APPROACH` of the point the object is taken by,
+  and at least half way there from where it started;
 * ``carry``: the object is held off its start for `CARRY_FRAMES` frames in a row;
 * ``approach_goal``: the object, held, is within `APPROACH_GOAL` of its goal in the table
   plane (over its bin, peg or the cube below);
@@ -31,10 +32,12 @@ def achieved(component: str, facts: Sequence[FrameFacts], events: Sequence[Event
     """Whether the video shows one component (see the module docstring for the kinds)."""
     kind, _, obj = component.partition(":")
     if kind == "approach":
-        return any(
-            (o := f.objects.get(obj)) is not None and o.reach is not None and o.reach <= APPROACH
-            for f in facts
-        )
+        reach = [o.reach for f in facts if (o := f.objects.get(obj)) and o.reach is not None]
+        if not reach:
+            return False
+        # within APPROACH, and at least half way from where the gripper started (a part
+        # that starts 12 cm from the hand is not "approached" by standing still)
+        return min(reach) <= min(APPROACH, 0.5 * reach[0])
     if kind == "carry":
         run = 0
         for f in facts:

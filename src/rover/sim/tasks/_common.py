@@ -39,6 +39,19 @@ def named_levels(milestones: Sequence[Sequence[str]], names: Sequence[str]) -> l
     return [lv.model_copy(update={"name": n}) for lv, n in zip(levels, names, strict=True)]
 
 
+def contact_before_grasp(levels: list[LevelSpec], level: int = 3) -> list[LevelSpec]:
+    """An articulated task's "contact" level stops near the end of the grasp subtask
+    (fingers at the handle, not yet closed on it) instead of just after the grasp: random
+    actions from a closed grasp pull the part open, so that ending would show the next
+    level ("start opening")."""
+    return [
+        lv.model_copy(update={"terminate_subtask": 0, "terminate_at": (0.8, 0.95)})
+        if lv.level == level
+        else lv
+        for lv in levels
+    ]
+
+
 def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
     """App. B Table 5, pick-and-place group: seven levels."""
     return named_levels(

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rover.sim.tasks._common import FINGERS, named_levels
+from rover.sim.tasks._common import FINGERS, contact_before_grasp, named_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 OPEN_ANGLE = 0.35  # rad of hinge travel counted as "completely open" (robosuite: > 0.3)
@@ -36,15 +36,17 @@ DOOR = TaskSpec(
             end_signal="opened:door",
         ),
     ],
-    levels=named_levels(
-        [["Approach the door"], ["Start opening the door"]],
-        [
-            "Fail to approach the door",
-            "Approach the door",
-            "Contact the door",
-            "Start opening the door",
-            "Finish opening the door",
-        ],
+    levels=contact_before_grasp(
+        named_levels(
+            [["Approach the door"], ["Start opening the door"]],
+            [
+                "Fail to approach the door",
+                "Approach the door",
+                "Contact the door",
+                "Start opening the door",
+                "Finish opening the door",
+            ],
+        )
     ),
     milestones=["approach:door", "contact:door", "open_start:door", "open_finish:door"],
     qa_templates=[
