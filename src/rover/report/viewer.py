@@ -11,6 +11,7 @@ only text (axis labels, tick numbers) is escaped on the way in.
 from __future__ import annotations
 
 import html
+import os
 import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -105,15 +106,20 @@ def _episode_view(
     indices = sorted({f.index for t in traces for f in t.frames})
     saved = run.thumbs(eid, entries[0].view or traces[0].view)
     thumbs = []
-    if saved:
-        folder = out / "frames" / slug
-        folder.mkdir(parents=True, exist_ok=True)
-        for ix in indices or sorted(saved):
-            if ix in saved:
-                dest = folder / saved[ix].name
-                if not dest.exists():
-                    shutil.copyfile(saved[ix], dest)
-                thumbs.append((ix, f"../frames/{slug}/{dest.name}"))
+    # a report inside its run (the default) points at the run's frames; one written
+    # elsewhere gets its own copies, so it can be moved on its own
+    inside = out.resolve().is_relative_to(run.run_dir.resolve())
+    for ix in indices or sorted(saved):
+        if ix not in saved:
+            continue
+        if inside:
+            thumbs.append((ix, os.path.relpath(saved[ix], out / "episodes")))
+            continue
+        dest = out / "frames" / slug / saved[ix].name
+        if not dest.exists():
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(saved[ix], dest)
+        thumbs.append((ix, f"../frames/{slug}/{dest.name}"))
     note = "" if thumbs else "frames unavailable: this run kept no frames for the episode"
     truth: list[tuple[int, float]] = []
     if episode is not None and episode.truth is not None:
