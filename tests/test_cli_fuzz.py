@@ -293,6 +293,7 @@ def _generate_cases() -> list[Case]:
         (["--levels", "99"], "--levels"),
         (["--levels", "abc"], "--levels"),
         (["--frames", "-1"], "--frames"),
+        (["--frames", "1000000"], "--frames"),
         (["--size", "0"], "--size"),
         (["--size", "-5"], "--size"),
         (["--size", "100000"], "--size"),
