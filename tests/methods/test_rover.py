@@ -280,3 +280,20 @@ async def test_prose_needs_to_never_nests_and_the_plan_is_followed(make_episode,
     assert all(c.children == [] for c in root.children)  # no line four deep
     assert trace.progress()[-1] == pytest.approx(100)
     assert trace.frames[1].description.startswith("The gripper moves, so the robot needs to")
+
+
+async def test_implausible_first_reply_is_reasked_not_a_finished_line(make_episode, scripted):
+    """A first-frame "250%" (seen from real models) must not end ROVER after one call."""
+
+    def wild_start(p: Prompt) -> str:
+        pos = p.meta.positions[-1]
+        value = 250 if pos == 1 else 20 * pos
+        return f"Frame description: f{pos}\nSubtask completion percentage: {value}%"
+
+    vlm = scripted(wild_start)
+    trace = await get_method("rover-no-recursion").run(make_episode(5), vlm)
+    # frame 1 asked twice (reminder), then carried; the line runs to the end of the video
+    assert [c.parse for c in trace.calls] == ["ok", "retried", "failed", "ok", "ok", "ok"]
+    assert trace.tree.outcome == "end_of_video"
+    assert trace.progress()[-1] == pytest.approx(80)
+    assert trace.frames[1].predicted is False

@@ -61,6 +61,17 @@ class _Line:
     last_position: int = 0
 
 
+# A step's percentage outside this range is not a reading of the frame (a first reply of
+# "250%" would otherwise end the line after one call): it is re-asked with the format
+# reminder, and if the second reply is no better the step carries the last value.
+PLAUSIBLE_PROGRESS = (-100.0, 150.0)
+
+
+def _plausible(reply: StepReply) -> bool:
+    lo, hi = PLAUSIBLE_PROGRESS
+    return reply.progress is not None and lo <= reply.progress <= hi
+
+
 class Rover(Method):
     """ROVER with a sliding window of `window` frames (None: the whole line).
 
@@ -322,7 +333,7 @@ class Rover(Method):
             content,
             meta,
             parse_step,
-            lambda r: r.progress is not None or r.task_complete or (can and bool(r.new_subtask)),
+            lambda r: _plausible(r) or r.task_complete or (can and bool(r.new_subtask)),
             reminder,
             line_id=line.id,
         )
