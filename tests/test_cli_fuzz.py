@@ -323,6 +323,7 @@ def _generate_cases() -> list[Case]:
 E = ["eval", "--methods", "rover", "--frames", "4", "--no-cache"]
 
 
+
 def _eval_cases() -> list[Case]:
     out = ["--out", "{t}/evalrun"]
     ds = ["--dataset", "{t}/ds"]
@@ -381,6 +382,9 @@ def _eval_cases() -> list[Case]:
         c.append(Case(f"eval: {' '.join(extra)[:40]}", argv, names))
     for i, case in enumerate(c):  # each case its own run directory
         case.argv = [a.replace("{t}/evalrun", f"{{t}}/evalrun{i}") for a in case.argv]
+        if "--backend" not in case.argv:  # eval has no default backend: the oracle, offline
+            case.argv += ["--backend", "oracle"]
+    c.append(Case("eval: no backend chosen", [*E, *ds, *out], "no VLM backend chosen"))
     return c
 
 

@@ -16,7 +16,9 @@ runner = CliRunner()
 
 
 def _eval(*args: str):
-    return runner.invoke(app, ["eval", *args], catch_exceptions=False)
+    """`rover eval ARGS`, on the oracle unless ARGS name a backend (eval has no default)."""
+    backend = [] if "--backend" in args else ["--backend", "oracle"]
+    return runner.invoke(app, ["eval", *args, *backend], catch_exceptions=False)
 
 
 def _metrics(out: Path) -> dict:
@@ -183,7 +185,8 @@ def test_llm_judge_and_answerer_over_http(tmp_path: Path, make_dataset, loopback
 
 
 def _main(monkeypatch, capsys, *args: str) -> tuple[int, str]:
-    monkeypatch.setattr(sys, "argv", ["rover", "eval", *args])
+    backend = [] if "--backend" in args else ["--backend", "oracle"]
+    monkeypatch.setattr(sys, "argv", ["rover", "eval", *args, *backend])
     with pytest.raises(SystemExit) as exc:
         cli.main()
     return exc.value.code, capsys.readouterr().err
@@ -295,3 +298,26 @@ def test_resume_after_judge_failures_needs_no_video(tmp_path: Path, make_dataset
         r.get("error_rate") is None and r["stage_error"].startswith("judge: ")
         for r in m["per_trace"]
     )
+
+
+def test_eval_without_a_backend_names_the_choices(monkeypatch, capsys, tmp_path: Path) -> None:
+    """No silent default: neither a paid API nor the oracle runs unless chosen."""
+    monkeypatch.delenv("ROVER_BACKEND", raising=False)
+    monkeypatch.setenv("ROVER_CONFIG", str(tmp_path / "none.toml"))
+    monkeypatch.setattr(sys, "argv", ["rover", "eval", "--dataset", "bundled", "--out", "x"])
+    with pytest.raises(SystemExit) as exc:
+        cli.main()
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "no VLM backend chosen" in err and "oracle" in err
+    assert len(err.strip().splitlines()) == 1
+    monkeypatch.setenv("ROVER_BACKEND", "nonsense:x")
+    with pytest.raises(SystemExit):
+        cli.main()
+    assert "unknown VLM spec 'nonsense:x'" in capsys.readouterr().err
+
+
+def test_a_bad_judge_spec_names_the_option(monkeypatch, capsys, make_dataset, tmp_path) -> None:
+    ds = make_dataset(tmp_path / "ds", n=1, frames=4)
+    args = ["--dataset", str(ds), "--judge", "bogus", "--out", str(tmp_path / "run")]
+    code, err = _main(monkeypatch, capsys, *args)
+    assert code == 2 and err.strip().startswith("error: --judge: unknown VLM spec 'bogus'")

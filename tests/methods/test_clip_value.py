@@ -95,6 +95,7 @@ def test_clip_value_through_rover_eval(make_episode, tiny_clip, tmp_path):
     write_episode(ds, make_episode(6, episode_id="a"))
     out = tmp_path / "run"
     args = ["eval", "--dataset", str(ds), "--methods", "clip-value,rover", "--out", str(out)]
+    args += ["--backend", "oracle"]
     missing = CliRunner().invoke(app, args)
     assert missing.exit_code != 0 and "--model-path" in str(missing.exception or missing.output)
     done = CliRunner().invoke(app, [*args, "--model-path", str(tiny_clip)])

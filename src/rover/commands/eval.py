@@ -57,13 +57,15 @@ def eval_command(
         str, typer.Option("--methods", help="Comma-separated method names.")
     ] = "rover,gvl,temporal-concat,local-concat",
     backend: Annotated[
-        str,
+        str | None,
         typer.Option(
             "--backend",
             "--vlm",
-            help="VLM spec(s), comma-separated (" + vo.VLM_HELP.removeprefix("VLM spec: ") + ")",
+            help="VLM spec(s), comma-separated ("
+            + vo.VLM_HELP.removeprefix("VLM spec: ")
+            + "); default: ROVER_BACKEND or the config file",
         ),
-    ] = "oracle",
+    ] = None,
     judge: Annotated[
         str, typer.Option("--judge", help="Task 2 judge: 'rule', a VLM spec, or 'none'.")
     ] = "rule",
@@ -183,7 +185,7 @@ def eval_command(
         if source
         else [],
         methods=parse_name_list(methods, "--methods"),
-        backends=split_backend_specs(backend),
+        backends=split_backend_specs(vo.resolve_backend(backend)),
         judge=judge.strip(),
         answerer=answerer.strip(),
         frames=parse_int_list(frames, "--frames", minimum=2),

@@ -78,15 +78,20 @@ def needed_views(variants: list[Variant]) -> list[str | None]:
     return list(dict.fromkeys(v.view for v in variants))
 
 
+def is_real_source(origin: str) -> bool:
+    """True for recorded data (LeRobot, RLDS, HDF5, videos, frame folders), False for a
+    rover dataset directory, whose episodes carry the simulator's ground truth."""
+    return origin.startswith(("lerobot:", "rlds:", "hdf5:")) or not (
+        (Path(origin) / "dataset.json").exists()
+    )
+
+
 def load_for_variants(ref: EpisodeRef, variants: list[Variant]) -> tuple[Episode, Episode]:
     """(metadata of the whole episode, episode with the pixels the variants need).
 
     Blocking (decodes video): call through `asyncio.to_thread`.
     """
-    if (
-        ref.origin.startswith(("lerobot:", "rlds:", "hdf5:"))
-        or not (Path(ref.origin) / "dataset.json").exists()
-    ):
+    if is_real_source(ref.origin):
         return _load_from_source(ref, variants)
     root = Path(ref.origin)
     meta = read_episode(root, ref.source_id, load_frames=False)

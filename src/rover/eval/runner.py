@@ -26,6 +26,7 @@ from rover.errors import InputError, RoverError
 from rover.eval.episodes import (
     EpisodeRef,
     dataset_refs,
+    is_real_source,
     load_for_variants,
     source_refs,
     variant_episode,
@@ -169,8 +170,8 @@ class Runner:
         self.vlms = {
             b: given.get(b) or _load_backend(b, opts.backend_config) for b in opts.backends
         }
-        self.judge_vlm = self._aux(opts.judge)
-        self.answer_vlm = self._aux(opts.answerer)
+        self.judge_vlm = self._aux(opts.judge, "--judge")
+        self.answer_vlm = self._aux(opts.answerer, "--answerer")
         # every finished call counts at once (the display moves during long episodes)
         self.vlms = {b: Counted(v, self._count_call) for b, v in self.vlms.items()}
         if self.judge_vlm is not None:
@@ -183,7 +184,7 @@ class Runner:
         self.state.tokens += tokens
         self.on_update(self.state)
 
-    def _aux(self, spec: str) -> Any:
+    def _aux(self, spec: str, option: str) -> Any:
         if spec.lower() in OFF or spec.lower() == "rule":
             return None
         if spec.strip().lower() == "oracle":
@@ -194,7 +195,10 @@ class Runner:
         if spec in self.vlms or spec in self._given:
             return self.vlms.get(spec) or self._given[spec]
         config = self.opts.backend_config.model_copy(update={"flip_prob": 0.0, "jitter": 0.0})
-        return _load_backend(spec, config)
+        try:
+            return _load_backend(spec, config)
+        except InputError as exc:  # name the option: the spec alone does not say which one
+            raise InputError(f"{option}: {exc}") from exc
 
     def _pending(self, ref: EpisodeRef) -> list[Variant]:
         return [
@@ -401,6 +405,14 @@ def prepare_run(
             raise InputError(f"--model-path {opts.model_path}: no such folder")
     variants = build_variants(opts)
     refs = episode_refs(opts)
+    real = [r for r in refs if is_real_source(r.origin)]
+    if real and any(b.strip().lower() == "oracle" for b in opts.backends):
+        # recorded videos carry frame-number truth only, which the oracle would echo back
+        # as a perfect score: refused here, before any work, not once per work unit
+        raise InputError(
+            f"the oracle answers from simulator ground truth and {real[0].origin} has none: "
+            "use a real backend (openai:, gemini:, hf:) or replay:"
+        )
     _warm_up()
     config = run_config(opts, variants, refs)
     # backends load before anything is written, so a bad spec leaves no half-made run dir

@@ -97,7 +97,11 @@ TemperatureOpt = Annotated[
     float | None, typer.Option("--temperature", help="Sampling temperature (default 0).")
 ]
 MaxTokensOpt = Annotated[
-    int | None, typer.Option("--max-tokens", help="Most tokens per answer (default 512).")
+    int | None,
+    typer.Option(
+        "--max-tokens",
+        help="Most tokens per answer for every call (default: sized to what each call asks).",
+    ),
 ]
 DeviceOpt = Annotated[
     str | None, typer.Option("--device", help="hf backend device: cpu, cuda, cuda:1 ...")
