@@ -323,7 +323,6 @@ def _generate_cases() -> list[Case]:
 E = ["eval", "--methods", "rover", "--frames", "4", "--no-cache"]
 
 
-
 def _eval_cases() -> list[Case]:
     out = ["--out", "{t}/evalrun"]
     ds = ["--dataset", "{t}/ds"]

@@ -204,3 +204,11 @@ def test_sweep_figures_from_a_real_eval_run(make_run, tmp_path: Path) -> None:
     for label in ("ROVER · 5 frames", "ROVER (window 6) · 10 frames", "GVL · 5 frames"):
         assert label in page
     assert "Shown at 10 frames per video" in page
+
+
+def test_a_non_utf8_run_json_is_one_line_naming_the_file(tmp_path) -> None:
+    from rover.run.store import RunStore
+
+    (tmp_path / "run.json").write_bytes(b"\xff\xfe not json")
+    with pytest.raises(InputError, match=r"run\.json: not a rover run configuration"):
+        RunStore(tmp_path).config()

@@ -1,8 +1,8 @@
 """run.json: what a run was asked to do, which software did it, and how it was invoked.
 
-Backend specs and the command line are stored with anything secret-looking replaced by
-`***` (values of options named like keys/tokens/passwords, `sk-...`/`AIza...` strings,
-credentials in URLs), so a run directory can be shared as it is.
+Backend specs and the command line are stored through the one scrubber (rover.vlm.scrub:
+keys, URL credentials, `sk-...`/`AIza...` tokens); values of options named like
+keys/tokens/passwords are replaced by `***`, so a run directory can be shared as it is.
 """
 
 from __future__ import annotations
@@ -22,12 +22,6 @@ if TYPE_CHECKING:
 
 MASK = "***"
 _SECRET_OPT = re.compile(r"^--?[\w-]*(key|token|secret|password|passwd|auth)[\w-]*$", re.I)
-_SECRET_VALUE = re.compile(
-    r"(sk-[A-Za-z0-9_\-]{8,}|AIza[0-9A-Za-z_\-]{20,}|(?i:bearer)\s+[A-Za-z0-9._\-]{8,}"
-    r"|hf_[A-Za-z0-9]{16,})"
-)
-_URL_CREDS = re.compile(r"(://)[^/@\s:]+:[^/@\s]+@")
-_QUERY_SECRET = re.compile(r"([?&](?:api[_-]?key|key|token|access_token|secret)=)[^&\s]+", re.I)
 # key-name options whose value is the *name* of an environment variable, not a secret
 _SAFE_OPTS = {"--api-key-env"}
 _PACKAGES = (
@@ -48,10 +42,10 @@ _PACKAGES = (
 
 
 def scrub_text(text: str) -> str:
-    """`text` with key-shaped strings, URL credentials and secret query values masked."""
-    text = _SECRET_VALUE.sub(MASK, text)
-    text = _URL_CREDS.sub(r"\1" + MASK + "@", text)
-    return _QUERY_SECRET.sub(r"\1" + MASK, text)
+    """`text` through the one scrubber (rover.vlm.scrub): keys, URL credentials, tokens."""
+    from rover.vlm.scrub import scrub
+
+    return scrub(text)
 
 
 def scrub_argv(argv: list[str]) -> list[str]:

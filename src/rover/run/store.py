@@ -70,7 +70,7 @@ class RunStore:
         try:
             raw = json.loads(path.read_text())
             RunConfig.model_validate(raw)
-        except (json.JSONDecodeError, ValidationError) as exc:
+        except (json.JSONDecodeError, UnicodeDecodeError, ValidationError) as exc:
             raise InputError(f"{path}: not a rover run configuration ({_why(exc)})") from exc
         return raw
 
@@ -84,7 +84,7 @@ class RunStore:
             try:
                 raw = json.loads(path.read_text())
                 Metrics.model_validate(raw)
-            except (json.JSONDecodeError, ValidationError) as exc:
+            except (json.JSONDecodeError, UnicodeDecodeError, ValidationError) as exc:
                 log.warning("%s unreadable (%s): rescoring the run", path, _why(exc))
                 raw = None
         if raw is None or raw.get("schema_version") != SCHEMA_VERSION:
