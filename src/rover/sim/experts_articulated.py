@@ -20,7 +20,7 @@ TURN_LEAD = 0.35  # rad the hand's yaw runs ahead of the knob while turning
 KNOB_DZ = 0.022  # m above the knob's centre the fingers grip it
 
 
-def _latch(sim: SimEnv) -> Callable[[], np.ndarray]:
+def latch(sim: SimEnv) -> Callable[[], np.ndarray]:
     """A target frozen at wherever the hand is the first time it is asked for."""
     held: list[np.ndarray] = []
 
@@ -43,7 +43,7 @@ def _drawer(sim: SimEnv, closing: bool) -> list[Phase]:
         step = -LEAD if closing else LEAD
         return fx.site_at("handle", fx.joint_value() + step)
 
-    hold, rest = _latch(sim), _latch(sim)
+    hold, rest = latch(sim), latch(sim)
     return [
         Phase(
             lambda: handle() + np.array([0, 0, 0.08]), OPEN, tol=0.012, steps=80, yaw=lambda: yaw
@@ -98,7 +98,7 @@ def knob_script(sim: SimEnv) -> list[Phase]:
     def knob_yaw() -> float:  # let go without turning the knob back
         return yaw0 + fx.joint_value()
 
-    hold, rest = _latch(sim), _latch(sim)
+    hold, rest = latch(sim), latch(sim)
     return [
         Phase(lambda: grip() + np.array([0, 0, 0.08]), OPEN, tol=0.012, steps=80, yaw=lambda: yaw0),
         Phase(grip, OPEN, tol=0.006, steps=40, gain=1.5),

@@ -16,6 +16,7 @@ from collections.abc import Callable
 import numpy as np
 
 from rover.sim.env import SimEnv
+from rover.sim.experts_articulated import latch
 from rover.sim.motions import CLOSE, OPEN, Phase, wrap_angle
 
 TURN_LEAD = 0.35  # rad the hand's yaw runs ahead of a dial while turning it
@@ -24,17 +25,6 @@ GRIP_DZ = 0.022  # m above a dial's centre the fingers grip it
 # yaw (fixture frame, part at joint 0) at which the fingers close across the grasp point
 GRIP_YAW = {"knob": np.pi / 2, "door": np.pi / 2, "spout": 0.0}
 SWING_SITE = {"door": "handle", "spout": "tip"}
-
-
-def _latch(sim: SimEnv) -> Callable[[], np.ndarray]:
-    held: list[np.ndarray] = []
-
-    def point() -> np.ndarray:
-        if not held:
-            held.append(sim.point("eef"))
-        return held[0]
-
-    return point
 
 
 def _base_yaw(fx) -> float:
@@ -76,7 +66,7 @@ def turn_script(sim: SimEnv) -> list[Phase]:
     def knob_yaw() -> float:
         return base + fx.joint_value()
 
-    hold, rest = _latch(sim), _latch(sim)
+    hold, rest = latch(sim), latch(sim)
     start = knob_yaw()
     return [
         Phase(
@@ -113,7 +103,7 @@ def swing_script(sim: SimEnv) -> list[Phase]:
     def along() -> np.ndarray:
         return fx.site_at(site, _ahead(fx, SWING_LEAD))
 
-    hold, rest = _latch(sim), _latch(sim)
+    hold, rest = latch(sim), latch(sim)
     start = part_yaw()
     return [
         Phase(

@@ -15,6 +15,7 @@ import numpy as np
 
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.tasks._common import FINGERS, named_levels
+from rover.sim.tasks.articulated import drawer_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"
@@ -71,8 +72,6 @@ def _reach(name: str, obj: str, point: str, signal: str) -> SubtaskSpec:
 
 # --------------------------------------------------------------- doors/drawers
 def _drawer(closing: bool) -> TaskSpec:
-    verb, ing = ("close", "closing") if closing else ("open", "opening")
-    push, end = ("push", "closed") if closing else ("pull", "open")
     kwargs = {"fixture": "Drawer", "part": "drawer"}
     if closing:  # closed = at most 10% open: 93% of the way from 14 cm
         kwargs.update(start_q=DRAWER_START_OPEN, target=0.0, reach=0.93)
@@ -81,55 +80,9 @@ def _drawer(closing: bool) -> TaskSpec:
     return _spec(
         "CloseDrawer" if closing else "OpenDrawer",
         env_kwargs=kwargs,
-        description=f"Grasp the drawer handle and {push} the drawer {end}.",
         group="doors_drawers",
         objects=[_part("drawer", "Drawer", "drawer", "centre", handle="handle")],
-        goals={f"drawer_{verb}": GoalSpec(kind="fixture", object="drawer", body="handle")},
-        subtasks=[
-            _reach("grasp the drawer handle", "drawer", "drawer:handle", "grasped:drawer"),
-            _move(
-                f"{push} the drawer {end}",
-                "drawer",
-                "drawer:handle",
-                f"goal:drawer_{verb}",
-                f"drawer_{'closed' if closing else 'opened'}:drawer",
-            ),
-        ],
-        levels=named_levels(
-            [["Approach the drawer"], [f"Start {ing} the drawer"]],
-            [
-                "Fail to approach the drawer",
-                "Approach the drawer",
-                "Contact the drawer",
-                f"Start {ing} the drawer",
-                f"Finish {ing} the drawer",
-            ],
-        ),
-        milestones=[
-            "approach:drawer",
-            "contact:drawer",
-            f"{verb}_start:drawer",
-            f"{verb}_finish:drawer",
-        ],
-        qa_templates=_qa(
-            "drawer",
-            [
-                ("did_contact", "Did the robot contact the drawer handle? If so, when?", "contact"),
-                ("did_grasp", "Did the robot grasp the drawer handle? If so, when?", "grasp"),
-                (
-                    f"did_{verb}_start",
-                    f"Did the robot start {ing} the drawer? If so, when?",
-                    f"{verb}_start",
-                ),
-                (
-                    f"did_{verb}_finish",
-                    f"Did the robot completely {verb} the drawer? If so, when?",
-                    f"{verb}_finish",
-                ),
-            ],
-        ),
-        expert="drawer_close" if closing else "drawer_open",
-        max_expert_steps=300,
+        **drawer_protocol(closing),
     )
 
 

@@ -9,6 +9,8 @@ rows for each group and QA templates follow App. C.3.
 
 from __future__ import annotations
 
+from typing import Any
+
 from rover.sim.tasks._common import FINGERS, named_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
@@ -27,20 +29,17 @@ def _qa(items: list[tuple[str, str, str]], obj: str) -> list[QATemplate]:
     return [QATemplate(id=i, text=t, event=e, object=obj) for i, t, e in items]
 
 
-def _drawer_task(name: str, closing: bool) -> TaskSpec:
+def drawer_protocol(closing: bool) -> dict[str, Any]:
+    """A drawer task wherever the drawer stands: its sentence, goal, subtasks, Table 5
+    levels and milestones, App. C.3 questions and expert. The tabletop and kitchen suites
+    differ only in the environment around the drawer, so both build from this."""
     verb, signal = ("close", "drawer_closed") if closing else ("open", "drawer_opened")
     ing = "closing" if closing else "opening"
     push, end = ("push", "closed") if closing else ("pull", "open")
-    return TaskSpec(
-        name=name,
-        env_name="RoverDrawer",
-        # closed = at most 10% open (1.2 cm): 93% of the way from 14 cm
-        env_kwargs={"start_q": DRAWER_START_OPEN, "target": 0.0, "reach": 0.93} if closing else {},
-        description=f"Grasp the drawer handle and {push} the drawer {end}.",
-        group="drawers",
-        objects=[_DRAWER],
-        goals={f"drawer_{verb}": GoalSpec(kind="fixture", object="drawer", body="handle")},
-        subtasks=[
+    return {
+        "description": f"Grasp the drawer handle and {push} the drawer {end}.",
+        "goals": {f"drawer_{verb}": GoalSpec(kind="fixture", object="drawer", body="handle")},
+        "subtasks": [
             SubtaskSpec(
                 name="grasp the drawer handle",
                 object="drawer",
@@ -59,7 +58,7 @@ def _drawer_task(name: str, closing: bool) -> TaskSpec:
                 end_signal=f"{signal}:drawer",
             ),
         ],
-        levels=named_levels(
+        "levels": named_levels(
             [["Approach the drawer"], [f"Start {ing} the drawer"]],
             [
                 "Fail to approach the drawer",
@@ -69,13 +68,13 @@ def _drawer_task(name: str, closing: bool) -> TaskSpec:
                 f"Finish {ing} the drawer",
             ],
         ),
-        milestones=[
+        "milestones": [
             "approach:drawer",
             "contact:drawer",
             f"{verb}_start:drawer",
             f"{verb}_finish:drawer",
         ],
-        qa_templates=_qa(
+        "qa_templates": _qa(
             [
                 ("did_contact", "Did the robot contact the drawer handle? If so, when?", "contact"),
                 ("did_grasp", "Did the robot grasp the drawer handle? If so, when?", "grasp"),
@@ -92,8 +91,20 @@ def _drawer_task(name: str, closing: bool) -> TaskSpec:
             ],
             "drawer",
         ),
-        expert="drawer_close" if closing else "drawer_open",
-        max_expert_steps=300,
+        "expert": "drawer_close" if closing else "drawer_open",
+        "max_expert_steps": 300,
+    }
+
+
+def _drawer_task(name: str, closing: bool) -> TaskSpec:
+    return TaskSpec(
+        name=name,
+        env_name="RoverDrawer",
+        # closed = at most 10% open (1.2 cm): 93% of the way from 14 cm
+        env_kwargs={"start_q": DRAWER_START_OPEN, "target": 0.0, "reach": 0.93} if closing else {},
+        group="drawers",
+        objects=[_DRAWER],
+        **drawer_protocol(closing),
     )
 
 
