@@ -25,20 +25,12 @@ from rover.eval.qa import rule_answer_trace
 from rover.eval.results import compute_metrics, write_results
 from rover.eval.rundir import RunDir, write_json_atomic
 from rover.eval.variants import expand_variants
+from rover.methods.registry import vlm_method_names
 from rover.methods.trace import CallRecord, FrameRecord, Trace
 from rover.report import build_report
 from rover.run.store import write_thumbs
 
-METHODS = [
-    "rover",
-    "rover-no-window",
-    "rover-no-recursion",
-    "gvl",
-    "gvl-single",
-    "temporal-concat",
-    "local-concat",
-    "video-concat",
-]
+METHODS = vlm_method_names()  # the paper's 8 VLM methods
 GROUPS = ["pick_and_place", "open_door", "stack", "turn_knob"]
 
 

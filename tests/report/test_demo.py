@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 import rover.sim
 from rover.cli import app
-from rover.commands.demo import DEMO_METHODS
+from rover.commands.demo import demo_methods
 
 
 def _check_demo_output(out: Path, output: str, episodes: int) -> None:
@@ -23,7 +23,7 @@ def _check_demo_output(out: Path, output: str, episodes: int) -> None:
     run = json.loads((out / "run" / "run.json").read_text())
     assert run["backends"] == ["oracle"]
     traces = list((out / "run" / "traces").rglob("*.json"))
-    assert len(traces) == episodes * len(DEMO_METHODS)
+    assert len(traces) == episodes * len(demo_methods())
     for name in ("ROVER", "GVL", "TemporalConcat", "LocalConcat", "VideoConcat"):
         assert name in output and name in page
     assert (out / "report" / "figures" / "pearson_by_group_level.png").exists()

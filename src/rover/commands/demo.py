@@ -24,17 +24,6 @@ from rover.console import esc, make_console
 from rover.errors import InputError, MissingExtraError
 from rover.paths import check_output_dir
 
-# every method that talks to a VLM (clip-value needs local embedding weights)
-DEMO_METHODS = [
-    "rover",
-    "rover-no-window",
-    "rover-no-recursion",
-    "gvl",
-    "gvl-single",
-    "temporal-concat",
-    "local-concat",
-    "video-concat",
-]
 FLIP_PROB = 0.1
 JITTER = 5.0
 GENERATE_TASKS = ["Lift", "Door"]
@@ -94,13 +83,21 @@ def demo(
     console.print(f"open it: {esc(index.resolve().as_uri())}", soft_wrap=True)
 
 
+def demo_methods() -> list[str]:
+    """Every method that talks to a VLM (clip-value needs local embedding weights)."""
+    from rover.methods.registry import vlm_method_names
+
+    return vlm_method_names()
+
+
 def _methods(text: str | None) -> list[str]:
+    allowed = demo_methods()
     if not text:
-        return list(DEMO_METHODS)
+        return allowed
     chosen = [m.strip() for m in text.split(",") if m.strip()]
-    unknown = [m for m in chosen if m not in DEMO_METHODS]
+    unknown = [m for m in chosen if m not in allowed]
     if unknown or not chosen:
-        raise InputError(f"demo methods must come from {', '.join(DEMO_METHODS)}; got {text!r}")
+        raise InputError(f"demo methods must come from {', '.join(allowed)}; got {text!r}")
     return chosen
 
 

@@ -42,6 +42,11 @@ def method_names() -> list[str]:
 NON_VLM_METHODS = _NON_VLM
 
 
+def vlm_method_names() -> list[str]:
+    """The methods that reason through a VLM (everything the oracle demo can run)."""
+    return [m for m in method_names() if m not in NON_VLM_METHODS]
+
+
 def get_method(name: str, **params: Any) -> Method:
     """A configured method; unknown names list the valid ones.
 
