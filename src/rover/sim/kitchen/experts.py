@@ -47,6 +47,24 @@ def _ahead(fx, lead: float) -> float:
     return min(q, end) if sign > 0 else max(q, end)
 
 
+def _grasp(
+    target: Callable[[], np.ndarray], hold: Callable[[], np.ndarray], start_yaw: float
+) -> list[Phase]:
+    """Come down on a part's grip point from 8 cm above, the wrist at the part's start yaw,
+    and close on it (both the dial and the swing experts begin this way)."""
+    return [
+        Phase(
+            lambda: target() + np.array([0, 0, 0.08]),
+            OPEN,
+            tol=0.012,
+            steps=80,
+            yaw=lambda: start_yaw,
+        ),
+        Phase(target, OPEN, tol=0.006, steps=40, gain=1.5),
+        Phase(hold, CLOSE, tol=None, steps=10),
+    ]
+
+
 def _finish(rest: Callable[[], np.ndarray], yaw: Callable[[], float]) -> list[Phase]:
     return [
         Phase(rest, OPEN, tol=None, steps=8, yaw=yaw, track_yaw=True),
@@ -67,13 +85,8 @@ def turn_script(sim: SimEnv) -> list[Phase]:
         return base + fx.joint_value()
 
     hold, rest = latch(sim), latch(sim)
-    start = knob_yaw()
     return [
-        Phase(
-            lambda: grip() + np.array([0, 0, 0.08]), OPEN, tol=0.012, steps=80, yaw=lambda: start
-        ),
-        Phase(grip, OPEN, tol=0.006, steps=40, gain=1.5),
-        Phase(hold, CLOSE, tol=None, steps=10),
+        *_grasp(grip, hold, knob_yaw()),
         Phase(
             hold,
             CLOSE,
@@ -104,13 +117,8 @@ def swing_script(sim: SimEnv) -> list[Phase]:
         return fx.site_at(site, _ahead(fx, SWING_LEAD))
 
     hold, rest = latch(sim), latch(sim)
-    start = part_yaw()
     return [
-        Phase(
-            lambda: handle() + np.array([0, 0, 0.08]), OPEN, tol=0.012, steps=80, yaw=lambda: start
-        ),
-        Phase(handle, OPEN, tol=0.006, steps=40, gain=1.5),
-        Phase(hold, CLOSE, tol=None, steps=10),
+        *_grasp(handle, hold, part_yaw()),
         Phase(
             along,
             CLOSE,
