@@ -86,3 +86,41 @@ def test_lerobot_itself_loads_the_export(exported):
     ds = lerobot_dataset.LeRobotDataset("rover/bundled", root=exported, download_videos=False)
     row = ds.hf_dataset[31]
     assert int(row["episode_index"]) == 1 and int(row["frame_index"]) == 1
+
+
+def test_stats_json_holds_every_feature_and_matches_the_frames(exported):
+    """meta/stats.json: what a LeRobot policy normalises with, recomputed from the export."""
+    info = json.loads((exported / "meta" / "info.json").read_text())
+    stats = json.loads((exported / "meta" / "stats.json").read_text())
+    assert set(stats) == set(info["features"])
+    data = pq.read_table(exported / "data" / "chunk-000" / "file-000.parquet").to_pydict()
+    progress = np.asarray(data["progress"], dtype=float)
+    assert stats["progress"]["count"] == [len(progress)]
+    assert np.isclose(stats["progress"]["mean"][0], progress.mean())
+    assert np.isclose(stats["progress"]["std"][0], progress.std())
+    assert stats["progress"]["min"] == [progress.min()] and stats["progress"]["max"] == [1.0]
+    back = open_source(f"lerobot:{exported}?camera=left", size=None)
+    frames = np.concatenate([back.read(i).frames() for i in back.episode_ids()]) / 255.0
+    left = stats["observation.images.left"]
+    assert np.asarray(left["mean"]).shape == (3, 1, 1) and left["count"] == [len(frames)]
+    assert np.allclose(np.asarray(left["mean"]).ravel(), frames.mean(axis=(0, 1, 2)))
+    assert np.allclose(np.asarray(left["std"]).ravel(), frames.std(axis=(0, 1, 2)))
+    rows = pq.read_table(exported / "meta" / "episodes" / "chunk-000" / "file-000.parquet")
+    first = rows.to_pylist()[0]
+    assert np.isclose(first["stats/progress/mean"][0], progress[:30].mean())
+    assert np.asarray(first["stats/observation.images.left/mean"]).shape == (3, 1, 1)
+
+
+def test_merged_stats_equal_the_stats_of_the_union():
+    from rover.io.lerobot_stats import column_stats, merge_stats, sample_positions
+
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=17), rng.normal(3.0, 2.0, size=40)
+    merged = merge_stats([column_stats(a.tolist()), column_stats(b.tolist())])
+    whole = column_stats(np.concatenate([a, b]).tolist())
+    for key in ("min", "max", "mean", "std", "count"):
+        assert np.allclose(merged[key], whole[key]), key
+    assert column_stats([None, None]) is None
+    assert sample_positions(30) == list(range(30))
+    long = sample_positions(5000)
+    assert long[0] == 0 and long[-1] == 4999 and 100 <= len(long) < 5000

@@ -4,6 +4,7 @@ Layout (field by field as LeRobot v3.0 publishes it; see docs/sources.md)::
 
     meta/info.json                       codebase_version "v3.0", fps, features, paths, totals
     meta/tasks.parquet                   task strings (pandas index "task") and task_index
+    meta/stats.json                      min/max/mean/std/count of every feature (normalisation)
     meta/episodes/chunk-000/file-000.parquet
                                          one row per episode: where its rows and frames lie,
                                          plus rover's episode truth under "rover/..."
@@ -33,6 +34,13 @@ import av
 from rover.episode import Episode, StateType
 from rover.errors import InputError
 from rover.io.dataset import episode_ids, read_dataset_info, read_episode
+from rover.io.lerobot_stats import (
+    as_json,
+    column_stats,
+    episode_columns,
+    merge_stats,
+    video_stats,
+)
 
 CODEBASE_VERSION = "v3.0"
 CHUNKS_SIZE = 1000  # LeRobot's DEFAULT_CHUNK_SIZE
@@ -42,6 +50,7 @@ DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
 EPISODES_PATH = "meta/episodes/chunk-000/file-000.parquet"
 TASKS_PATH = "meta/tasks.parquet"
+STATS_PATH = "meta/stats.json"
 STATE_TYPES = [s.value for s in StateType]
 CAMERA_PREFIX = "observation.images."
 TRUTH_FEATURES = ("progress", "state_type", "subtask_index", "level", "source_frame_index")
@@ -91,8 +100,10 @@ def export_lerobot(root: Path, out: Path, fps: int | None = None) -> dict[str, A
         )
     tasks = list(dict.fromkeys(ep.task for ep in episodes))
     starts = _starts([ep.num_frames for ep in episodes])
-    _write_data(tmp, episodes, tasks, starts, rate)
-    _write_episodes(tmp, episodes, views, starts, rate)
+    cols = _write_data(tmp, episodes, tasks, starts, rate)
+    per_episode = _episode_stats(root, episodes, views, starts, cols)
+    _write_episodes(tmp, episodes, views, starts, rate, per_episode)
+    _write_stats(tmp, per_episode)
     _write_tasks(tmp, tasks)
     meta = _info(info.name, episodes, views, sizes, tasks, rate)
     (tmp / "meta" / "info.json").write_text(json.dumps(meta, indent=4))
@@ -176,7 +187,9 @@ def _subtask_of(ep: Episode, pos: int) -> int:
     return -1
 
 
-def _write_data(tmp: Path, episodes: list[Episode], tasks: list[str], starts, fps) -> None:
+def _write_data(
+    tmp: Path, episodes: list[Episode], tasks: list[str], starts, fps
+) -> dict[str, list]:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -199,6 +212,29 @@ def _write_data(tmp: Path, episodes: list[Episode], tasks: list[str], starts, fp
     path = tmp / DATA_PATH.format(chunk_index=0, file_index=0)
     path.parent.mkdir(parents=True, exist_ok=True)
     pq.write_table(pa.table(cols, schema=schema), path)
+    return cols
+
+
+def _episode_stats(root: Path, episodes: list[Episode], views, starts, cols) -> list[dict]:
+    """Each episode's normalisation stats: its frame columns and a sample of its videos."""
+    out = []
+    for ep, start in zip(episodes, starts, strict=True):
+        stats = {}
+        for key, values in cols.items():
+            st = column_stats(values[start : start + ep.num_frames])
+            if st is not None:
+                stats[key] = st
+        for view in views:
+            path = root / "episodes" / ep.id / f"{view}.mp4"
+            stats[camera_key(view)] = video_stats(path, ep.num_frames)
+        out.append(stats)
+    return out
+
+
+def _write_stats(tmp: Path, per_episode: list[dict]) -> None:
+    keys = dict.fromkeys(k for st in per_episode for k in st)
+    merged = {k: merge_stats([st[k] for st in per_episode if k in st]) for k in keys}
+    (tmp / STATS_PATH).write_text(json.dumps(as_json(merged), indent=4))
 
 
 def _frame_columns() -> dict[str, Any]:
@@ -218,12 +254,14 @@ def _frame_columns() -> dict[str, Any]:
     }
 
 
-def _write_episodes(tmp: Path, episodes: list[Episode], views, starts, fps) -> None:
+def _write_episodes(
+    tmp: Path, episodes: list[Episode], views, starts, fps, per_episode: list[dict]
+) -> None:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     rows = []
-    for e, (ep, start) in enumerate(zip(episodes, starts, strict=True)):
+    for e, (ep, start, stats) in enumerate(zip(episodes, starts, per_episode, strict=True)):
         n = ep.num_frames
         truth = ep.truth
         row: dict[str, Any] = {
@@ -256,6 +294,7 @@ def _write_episodes(tmp: Path, episodes: list[Episode], views, starts, fps) -> N
         row["rover/facts"] = (
             json.dumps([f.model_dump(mode="json") for f in facts]) if facts is not None else None
         )
+        row.update(episode_columns(stats))
         rows.append(row)
     path = tmp / EPISODES_PATH
     path.parent.mkdir(parents=True, exist_ok=True)
