@@ -26,7 +26,8 @@ TRY_STRIDE = 1_000_003  # plan index offset between attempts (independent Genera
 RECOVERY_GAP = 0.015  # m an object may sit off the expert state a recovery hands over to
 HIGHEST_MIN_END = 0.95  # the top level must (almost) finish the task
 IDLE_POS = 0.002  # m: an expert step that moves no entity more than this is idle ...
-IDLE_GRIP = 0.01  # ... and changes the gripper opening less than this
+IDLE_GRIP = 0.01  # ... and changes the gripper opening less than this ...
+IDLE_JOINT = 0.01  # ... and no articulated joint (knob, drawer) moves this fraction of its range
 IDLE_KEEP = 2  # idle steps kept in a row (a short pause reads as a pause, not a stall)
 RETREAT_KEEP = 12  # expert steps kept after the task is done (the hand backs off)
 
@@ -39,19 +40,23 @@ def trim_demo(
     Scripted experts pause (fingers closing, settling, the final hold) and back off for a
     while once the task is done; sampled evenly, those stretches become runs of identical
     frames. A step is idle when no entity (hand, objects) moves more than `IDLE_POS` and
-    the gripper opening changes less than `IDLE_GRIP` since the last kept step; at most
-    `IDLE_KEEP` idle steps in a row are kept, and `RETREAT_KEEP` steps after the last
-    subtask's end. Subtask-end steps are always kept; ends are remapped.
+    the gripper opening changes less than `IDLE_GRIP` and no subtask joint more than
+    `IDLE_JOINT` since the last kept step; at most `IDLE_KEEP` idle steps in a row are
+    kept, and `RETREAT_KEEP` steps after the last subtask's end. Subtask-end steps are
+    always kept; ends are remapped.
     """
     n = len(states)
     last = min(n - 1, int(ends[-1]) + RETREAT_KEEP) if ends else n - 1
     must = set(int(e) for e in ends) | {0, last}
-    ents, grip = [], []
+    ents, grip, arts = [], [], []
+    # a knob turns on its axis (no point of it moves): its joint is watched as well
+    joints = sorted({s.joint for s in sim.spec.subtasks if getattr(s, "joint", None)})
     saved = sim.get_state()
     for s in states[: last + 1]:
         sim.set_state(s)
         ents.append(sim.entity_positions())
         grip.append(sim.gripper_opening())
+        arts.append(np.asarray([sim.point(j)[0] for j in joints], dtype=np.float64))
     sim.set_state(saved)
     keep = [0]
     idle = 0
@@ -59,7 +64,8 @@ def trim_demo(
         ref = keep[-1]
         moved = float(np.abs(ents[t] - ents[ref]).max()) > IDLE_POS
         gripped = abs(grip[t] - grip[ref]) > IDLE_GRIP
-        if moved or gripped or t in must:
+        turned = bool(joints) and float(np.abs(arts[t] - arts[ref]).max()) > IDLE_JOINT
+        if moved or gripped or turned or t in must:
             keep.append(t)
             idle = 0
         elif idle < IDLE_KEEP:
