@@ -54,6 +54,7 @@ class StepInfo:
     subtask_path: list[str] = field(default_factory=list)
     progress: float | None = None  # the value the model gave (its own line's scale)
     calls: int = 0
+    total: float | None = None  # full-task value as stitched so far (ROVER), when known
 
 
 OnStep = Callable[[StepInfo], None]
@@ -89,32 +90,50 @@ class Method:
 class Session:
     """One method run on one episode: encodes frames once, makes and records calls."""
 
+    # the pixel-hash memo of encoded images (a live stream keeps its own few frames instead)
+    memo_images = True
+
     def __init__(self, method: Method, episode: Episode, vlm: VLM, on_step: OnStep | None) -> None:
         self.episode = episode
-        self.vlm = vlm
-        self.on_step = on_step
-        self.frames = episode.frames()
-        self.encoding: ImageEncoding = getattr(vlm, "image_encoding", None) or ImageEncoding()
-        self._parts: dict[int, ImagePart] = {}
-        self.lines_started = 0  # ROVER: ids for lines of reasoning
-        self.budget = budget_for(vlm, method.max_tokens, method.tokens_per_frame)
-        make = getattr(vlm, "default_params", None)
-        self._params: SamplingParams = make() if callable(make) else SamplingParams()
+        self.frames: Any = episode.frames()  # position -> pixels (a live stream: a few)
+        self._begin(method, vlm, on_step)
         self.trace = Trace.start(
             episode, method.name, method.params, vlm.backend, vlm.model, oracle=is_oracle(vlm)
         )
 
+    def _begin(self, method: Method, vlm: VLM, on_step: OnStep | None) -> None:
+        """State every session has, whether its frames are a finished video or a stream."""
+        self.vlm = vlm
+        self.on_step = on_step
+        self.encoding: ImageEncoding = getattr(vlm, "image_encoding", None) or ImageEncoding()
+        self._parts: dict[int, ImagePart] = {}
+        self.lines_started = 0  # ROVER: ids for lines of reasoning
+        self.open_lines: list[Any] = []  # ROVER: the lines of reasoning running, root first
+        self.budget = budget_for(vlm, method.max_tokens, method.tokens_per_frame)
+        make = getattr(vlm, "default_params", None)
+        self._params: SamplingParams = make() if callable(make) else SamplingParams()
+
     @property
     def num_frames(self) -> int:
         return self.episode.num_frames
+
+    def frame_index(self, position: int) -> int:
+        """Original index of the frame at a sampled position."""
+        return self.episode.frame_indices[position]
+
+    async def has_frame(self, position: int) -> bool:
+        """Whether the video has a frame at `position` (a live stream waits to know)."""
+        return position < self.num_frames
 
     def image(self, position: int) -> ImagePart:
         """The image part of one frame; each frame is encoded once per run."""
         part = self._parts.get(position)
         if part is None:
             with _ENCODE_LOCK:
-                enc = EncodedImage.from_any(self.frames[position], self.encoding)
-            part = ImagePart(image=enc, frame_index=self.episode.frame_indices[position])
+                enc = EncodedImage.from_any(
+                    self.frames[position], self.encoding, memo=self.memo_images
+                )
+            part = ImagePart(image=enc, frame_index=self.frame_index(position))
             self._parts[position] = part
         return part
 
@@ -133,7 +152,7 @@ class Session:
         return PromptMeta(
             kind=kind,
             positions=list(positions),
-            frame_indices=[self.episode.frame_indices[p] for p in positions],
+            frame_indices=[self.frame_index(p) for p in positions],
             **kw,
         )
 
@@ -234,8 +253,14 @@ class Session:
         self.trace.calls.append(rec)
         return rec
 
-    def step(self, position: int, subtask_path: list[str], progress: float | None) -> None:
-        """Tell the live display a frame was answered."""
+    def step(
+        self,
+        position: int,
+        subtask_path: list[str],
+        progress: float | None,
+        total: float | None = None,
+    ) -> None:
+        """Tell the live display a frame was answered (`total`: full-task value, if known)."""
         if self.on_step is not None:
             self.on_step(
                 StepInfo(
@@ -244,6 +269,7 @@ class Session:
                     subtask_path=list(subtask_path),
                     progress=progress,
                     calls=len(self.trace.calls),
+                    total=total,
                 )
             )
 

@@ -34,7 +34,7 @@ from rover.errors import InputError
 from rover.methods.base import Method, OnStep, Session, text
 from rover.methods.parse import StepReply, parse_step
 from rover.methods.prompts import pct, render
-from rover.methods.stitch import Point, StitchLine, stitch
+from rover.methods.stitch import Point, StitchLine, child_scale, point_value, stitch
 from rover.methods.trace import LineNode, Trace
 from rover.methods.window import Seen, validate_window, window_frames
 from rover.vlm.types import VLM, ImagePart, TextPart
@@ -59,6 +59,13 @@ class _Line:
     last_progress: float = 0.0
     last_description: str | None = None
     last_position: int = 0
+    # live stitching (stitch.py's rule applied as the line runs, for `StepInfo.total`):
+    # the full-task value of this line's 0%, the points 100% of it is worth, the value at
+    # its last finished child's end (where the next child starts) and at its last answer
+    base: float = 0.0
+    scale: float = 100.0
+    start: float = 0.0
+    end: float = 0.0
 
 
 # A step's percentage outside this range is not a reading of the frame (a first reply of
@@ -120,8 +127,18 @@ class Rover(Method):
     async def run(self, episode: Episode, vlm: VLM, on_step: OnStep | None = None) -> Trace:
         vlm = vlm.bind(episode)
         s = Session(self, episode, vlm, on_step)  # all per-run state lives on s
+        return await self.reason(s, episode.task)
+
+    async def reason(self, s: Session, task: str) -> Trace:
+        """ROVER over the frames `s` gives, then the stitched trace.
+
+        The one implementation for finished videos (`run`) and live streams
+        (`rover.stream.RoverStream`, whose session waits for each pushed frame in
+        `has_frame`): frames are asked for strictly in order, and the video ends when
+        `has_frame` says there is no next frame.
+        """
         # ROVER(c, []) with c = task description + first observation (Sec. 3)
-        root = self._new_line(s, episode.task, [], 0, Seen(0, None, 0.0))
+        root = self._new_line(s, task, [], 0, Seen(0, None, 0.0))
         await self._line(s, root)
         curve, sources = stitch(root.stitch, s.num_frames)
         for pos, fr in enumerate(s.trace.frames):
@@ -139,7 +156,7 @@ class Rover(Method):
             id=s.lines_started,
             subtask=subtask,
             depth=depth,
-            first_frame=s.episode.frame_indices[first.position],
+            first_frame=s.frame_index(first.position),
             first_position=first.position,
         )
         s.lines_started += 1
@@ -160,10 +177,17 @@ class Rover(Method):
 
     async def _line(self, s: Session, line: _Line) -> _Line:
         """Algorithm 1 for one line; returns it ended (ψ reads its final frame/description)."""
+        s.open_lines.append(line)
+        try:
+            return await self._run_line(s, line)
+        finally:
+            s.open_lines.pop()
+
+    async def _run_line(self, s: Session, line: _Line) -> _Line:
         # the root's first call looks at frame 0 itself; a child starts from φ's frame
         t = line.first.position if line.first.description is None else line.first.position + 1
         while True:  # Alg. 1 line 2
-            if t >= s.num_frames:  # end of the video ends every open line
+            if not await s.has_frame(t):  # end of the video ends every open line
                 return self._end(s, line, "end_of_video")
             reply, ok = await self._step(s, line, t)  # line 3: Y = Y + Θ(c + Y)
             fr = s.trace.frames[t]
@@ -174,13 +198,13 @@ class Rover(Method):
             if t == line.first.position:
                 line.first = Seen(t, reply.description, 0.0)
             if not ok:  # unusable twice: record nothing, carry the last value, move on
-                s.step(t, line.path, line.last_progress)
+                s.step(t, line.path, line.last_progress, line.end)
                 t += 1
                 continue
             if reply.new_subtask and self._can_decompose(line):  # line 6: new task
                 self._take_plan(line, reply)
                 anchor = Seen(t, reply.description or line.last_description, 0.0)
-                s.step(t, [*line.path, reply.new_subtask], None)
+                s.step(t, [*line.path, reply.new_subtask], None, line.start)
                 child = await self._child(s, line, reply.new_subtask, anchor)  # line 7
                 nxt = await self._after_children(s, line, child)
                 if nxt is None:
@@ -201,6 +225,9 @@ class Rover(Method):
         child = self._new_line(s, subtask, [*parent.path, subtask], parent.depth + 1, anchor)
         parent.node.children.append(child.node)
         parent.stitch.items.append(child.stitch)
+        n = max(parent.stitch.planned, len(parent.node.children))
+        child.base, child.scale = parent.start, child_scale(parent.scale, n)
+        child.start = child.end = child.base
         fr = s.trace.frames[anchor.position]
         if not fr.predicted:
             fr.subtask_path, fr.subtask_progress = list(child.path), 0.0
@@ -216,7 +243,10 @@ class Rover(Method):
             line.completed.append(child.subtask)
             line.last_position = child.last_position
             line.last_description = child.last_description
-            if child.node.outcome == "end_of_video" or child.last_position >= s.num_frames - 1:
+            line.start = line.end = child.end
+            if child.node.outcome == "end_of_video" or not await s.has_frame(
+                child.last_position + 1
+            ):
                 return self._end_none(s, line, "end_of_video")
             reply, ok = await self._parent_turn(s, line, child)
             f = child.last_position
@@ -250,7 +280,7 @@ class Rover(Method):
     def _end(self, s: Session, line: _Line, outcome: str) -> _Line:
         line.node.outcome = outcome  # type: ignore[assignment]
         line.node.last_position = line.last_position
-        line.node.last_frame = s.episode.frame_indices[line.last_position]
+        line.node.last_frame = s.frame_index(line.last_position)
         line.node.final_description = line.last_description
         return line
 
@@ -269,8 +299,11 @@ class Rover(Method):
         previous = line.history[-1].progress if line.history else line.first.progress
         if self.policy == "always" or p != previous:
             line.history.append(Seen(t, desc, p))
+            if self.window is not None:  # the window shows at most window-2 of them
+                del line.history[: -(self.window - 1)]
         line.last_progress = p
-        s.step(t, line.path, p)
+        line.end = point_value(line.base, line.scale, p)
+        s.step(t, line.path, p, line.end)
 
     # -- prompts ---------------------------------------------------------------------------
 
@@ -373,7 +406,7 @@ class Rover(Method):
                 "completed": list(line.completed),
                 "plan": list(line.plan),
                 "at_position": f,
-                "at_frame": s.episode.frame_indices[f],
+                "at_frame": s.frame_index(f),
             },
         )
         line.node.calls += 1

@@ -56,6 +56,16 @@ class Value:
     line: StitchLine
 
 
+def point_value(base: float, scale: float, progress: float) -> float:
+    """Full-task value of a line's answer `progress` (0-100 of the line)."""
+    return base + scale * progress / 100.0
+
+
+def child_scale(scale: float, n_subtasks: int) -> float:
+    """Points of the full task one of a line's `n_subtasks` subtasks is worth."""
+    return scale / max(n_subtasks, 1)
+
+
 def line_values(
     line: StitchLine, base: float = 0.0, scale: float = 100.0
 ) -> tuple[dict[int, Value], dict[int, float], float]:
@@ -67,15 +77,15 @@ def line_values(
     """
     predicted: dict[int, Value] = {}
     anchors: dict[int, float] = {line.first_position: base}
-    n = max(line.n_subtasks, 1)
+    sub_scale = child_scale(scale, line.n_subtasks)
     start = end = base  # start: the value at the previous subtask's last frame
     for item in line.items:
         if isinstance(item, Point):
             # a decomposed line's own answers are on its own 0-100 scale
-            end = base + scale * item.progress / 100.0
+            end = point_value(base, scale, item.progress)
             predicted[item.position] = Value(end, item.progress, line)
         else:
-            sub_pred, sub_anchor, end = line_values(item, start, scale / n)
+            sub_pred, sub_anchor, end = line_values(item, start, sub_scale)
             predicted.update(sub_pred)
             for pos, v in sub_anchor.items():
                 anchors.setdefault(pos, v)

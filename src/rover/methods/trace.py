@@ -38,6 +38,7 @@ class CallRecord(BaseModel):
     prompt_tokens: int = 0
     completion_tokens: int = 0
     image_tokens: int = 0
+    cached_prompt_tokens: int = 0  # part of prompt_tokens the provider had cached (its report)
     usage_source: Literal["reported", "estimated"] = "estimated"
     latency_s: float = 0.0
     cached: bool = False
@@ -73,6 +74,7 @@ class Totals(BaseModel):
     prompt_tokens: int = 0
     completion_tokens: int = 0
     image_tokens: int = 0
+    cached_prompt_tokens: int = 0  # provider-reported prompt-prefix cache hits
     total_tokens: int = 0
     latency_s: float = 0.0
     parse_failures: int = 0
@@ -141,6 +143,7 @@ class Trace(BaseModel):
             t.prompt_tokens += c.prompt_tokens
             t.completion_tokens += c.completion_tokens
             t.image_tokens += c.image_tokens
+            t.cached_prompt_tokens += c.cached_prompt_tokens
             t.latency_s += c.latency_s
             t.parse_failures += int(c.parse == "failed")
             t.parse_retries += int(c.parse == "retried")

@@ -51,9 +51,15 @@ class EncodedImage(BaseModel):
 
     @classmethod
     def from_any(
-        cls, image: Image.Image | np.ndarray | str | Path | bytes, enc: ImageEncoding | None = None
+        cls,
+        image: Image.Image | np.ndarray | str | Path | bytes,
+        enc: ImageEncoding | None = None,
+        memo: bool = True,
     ) -> EncodedImage:
-        """Encode once: identical pixels with identical settings come back from a memo."""
+        """Encode once: identical pixels with identical settings come back from a memo.
+
+        `memo=False` neither reads nor fills the memo (a live stream sees every frame once
+        and keeps the few it still needs itself, so its memory stays flat)."""
         enc = enc or ImageEncoding()
         if isinstance(image, str | Path):
             if not Path(image).is_file():
@@ -71,7 +77,7 @@ class EncodedImage(BaseModel):
             image = image.convert("RGB")
             pixel_key = hashlib.sha256(image.tobytes() + str(image.size).encode()).hexdigest()
         memo_key = (pixel_key, enc.model_dump_json())
-        hit = _ENCODED.get(memo_key)
+        hit = _ENCODED.get(memo_key) if memo else None
         if hit is not None:
             _ENCODED.move_to_end(memo_key)
             return hit
@@ -94,6 +100,8 @@ class EncodedImage(BaseModel):
             height=pil.height,
             sha256=hashlib.sha256(data).hexdigest(),
         )
+        if not memo:
+            return out
         _ENCODED[memo_key] = out
         while len(_ENCODED) > _ENCODED_MAX:
             _ENCODED.popitem(last=False)
@@ -195,10 +203,19 @@ class Usage(BaseModel):
     completion_tokens: int = 0
     image_tokens: int = 0  # part of prompt_tokens, when known
     source: Literal["reported", "estimated"] = "estimated"
+    # part of prompt_tokens the provider served from its prompt-prefix cache (OpenAI and
+    # vLLM `prompt_tokens_details.cached_tokens`, Gemini `cached_content_token_count`);
+    # 0 when it reported none (old traces and caches read as 0 too)
+    cached_prompt_tokens: int = 0
 
     @property
     def total_tokens(self) -> int:
         return self.prompt_tokens + self.completion_tokens
+
+    @property
+    def uncached_prompt_tokens(self) -> int:
+        """Prompt tokens the provider processed afresh (billed at the full input price)."""
+        return max(self.prompt_tokens - self.cached_prompt_tokens, 0)
 
 
 class Completion(BaseModel):
