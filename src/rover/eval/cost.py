@@ -1,4 +1,10 @@
-"""Inference cost (App. G): tokens and VLM calls per video, by method and frame count."""
+"""Inference cost (App. G): tokens and VLM calls per video, by method and frame count.
+
+Prompt tokens are split into the part the provider reported serving from its prompt-prefix
+cache (`cached_prompt_tokens`: OpenAI/vLLM `cached_tokens`, Gemini
+`cached_content_token_count`) and the rest; the split is computed here once and every view
+(metrics.json, summary.md, the HTML report, the terminal line) reads these rows.
+"""
 
 from __future__ import annotations
 
@@ -24,6 +30,8 @@ def cost_row(trace: Trace) -> dict[str, Any]:
         "prompt_tokens": t.prompt_tokens,
         "completion_tokens": t.completion_tokens,
         "image_tokens": t.image_tokens,
+        "cached_prompt_tokens": t.cached_prompt_tokens,
+        "uncached_prompt_tokens": max(t.prompt_tokens - t.cached_prompt_tokens, 0),
         "cached_calls": t.cached_calls,
         "parse_failures": t.parse_failures,
         "latency_s": t.latency_s,
@@ -39,11 +47,21 @@ def truncated_replies(t: Totals) -> int | None:
     return None
 
 
+COST_METRICS = (
+    "total_tokens",
+    "calls",
+    "prompt_tokens",
+    "completion_tokens",
+    "cached_prompt_tokens",
+    "uncached_prompt_tokens",
+)
+
+
 def cost_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Mean ± SE tokens and calls per video for each (variant, frames) pair."""
     out = []
     ok = [r for r in rows if not r.get("error")]
-    for metric in ("total_tokens", "calls", "prompt_tokens", "completion_tokens"):
+    for metric in COST_METRICS:
         stats = group_mean_se(ok, metric, lambda r: (r["variant"], r["method"], _frames(r)))
         for (variant, method, n_frames), (mean, se, n) in sorted(
             stats.items(), key=lambda kv: tuple(map(str, kv[0]))

@@ -339,6 +339,13 @@ def render_summary(metrics: dict[str, Any], run: dict[str, Any]) -> str:
     return "\n".join(out).rstrip() + "\n"
 
 
+COST_NOTE = (
+    "Cached prompt tokens: the part of the prompt the provider reported serving from its "
+    "prompt-prefix cache (billed at its cached-input price where it has one); 0 when it "
+    "reports none (estimated usage, the oracle, servers without prefix caching)."
+)
+
+
 def _cost_table(metrics: dict[str, Any]) -> Table | None:
     rows: dict[tuple, dict[str, Any]] = {}
     labels = variant_names(metrics)
@@ -349,17 +356,28 @@ def _cost_table(metrics: dict[str, Any]) -> Table | None:
     body = []
     for (variant, frames), m in sorted(rows.items(), key=lambda kv: (str(kv[0][1]), kv[0][0])):
         tok, calls = m.get("total_tokens"), m.get("calls")
+        cached, fresh = m.get("cached_prompt_tokens"), m.get("uncached_prompt_tokens")
         body.append(
             [
                 labels.get(variant, variant),
                 str(frames),
                 _fmt(tok["mean"], tok["se"], 0) if tok else "–",
+                _fmt(cached["mean"], cached["se"], 0) if cached else "–",
+                _fmt(fresh["mean"], fresh["se"], 0) if fresh else "–",
                 _fmt(calls["mean"], calls["se"], 1) if calls else "–",
                 str(tok["n"] if tok else 0),
             ]
         )
-    headers = ["Method", "Frames", "Avg tokens per video", "Avg VLM calls per video", "n"]
-    return Table("cost", "Inference cost (App. F)", headers, body)
+    headers = [
+        "Method",
+        "Frames",
+        "Avg tokens per video",
+        "Cached prompt tokens",
+        "Uncached prompt tokens",
+        "Avg VLM calls per video",
+        "n",
+    ]
+    return Table("cost", "Inference cost (App. F)", headers, body, note=COST_NOTE)
 
 
 def _error_table(metrics: dict[str, Any]) -> Table | None:

@@ -240,6 +240,7 @@ class Session:
             prompt_tokens=u.prompt_tokens,
             completion_tokens=u.completion_tokens,
             image_tokens=u.image_tokens,
+            cached_prompt_tokens=u.cached_prompt_tokens,
             usage_source=u.source,
             latency_s=completion.latency_s,
             cached=completion.cached,

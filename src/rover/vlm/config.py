@@ -62,7 +62,24 @@ def default_backend() -> str | None:
     value = data.get("backend")
     if value is not None and not isinstance(value, str):
         raise InputError(f"{path}: 'backend' must be a VLM spec string")
-    return value.strip() or None if value else None
+    spec = value.strip() or None if value else None
+    return _with_pool(spec, data.get("base_urls"), path)
+
+
+def _with_pool(spec: str | None, urls: object, path: Path) -> str | None:
+    """`backend` plus the file's `base_urls = [...]` list (replicas of that model) as one
+    spec, `openai:<model>@<url>,<url>`."""
+    from rover.errors import InputError
+
+    if urls is None:
+        return spec
+    if not isinstance(urls, list) or not urls or not all(isinstance(u, str) for u in urls):
+        raise InputError(f"{path}: 'base_urls' must be a non-empty list of URL strings")
+    if spec is None or not spec.lower().startswith("openai:"):
+        raise InputError(f"{path}: 'base_urls' needs 'backend = \"openai:<model>\"' beside it")
+    if "@" in spec:
+        raise InputError(f"{path}: give the server once: in 'backend' after '@' or in 'base_urls'")
+    return spec + "@" + ",".join(u.strip() for u in urls)
 
 
 class BackendConfig(BaseModel):
@@ -97,8 +114,11 @@ class BackendConfig(BaseModel):
 
     # environment variable holding the API key (None = the provider's usual names)
     api_key_env: str | None = None
-    # endpoint override (openai: same as `openai:<model>@<url>`; gemini: REST base URL)
-    base_url: str | None = None
+    # endpoint override (openai: same as `openai:<model>@<url>`; gemini: REST base URL);
+    # openai: several URLs (a list, or comma-separated) are replicas of one model, a pool
+    base_url: str | list[str] | None = None
+    # seconds a pool replica that failed (connect error, 5xx, timeout) is passed over
+    pool_cooldown_s: float = Field(default=30.0, ge=0)
 
     # how images are encoded before they are sent
     image_format: Literal["JPEG", "PNG"] = "JPEG"

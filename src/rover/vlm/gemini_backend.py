@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from rover.errors import BackendError, MissingExtraError
+from rover.errors import BackendError, InputError, MissingExtraError
 from rover.vlm.base import BaseBackend, RawAnswer
 from rover.vlm.config import BackendConfig
 from rover.vlm.endpoint import check_base_url, endpoint_identity
@@ -42,7 +42,13 @@ class GeminiBackend(BaseBackend):
         super().__init__(model, config)
         _import_genai()
         install_log_scrubbing()
-        self.base_url = base_url or self.config.base_url
+        given = base_url or self.config.base_url
+        if isinstance(given, list | tuple) or (isinstance(given, str) and "," in given):
+            raise InputError(
+                f"gemini:{model}: endpoint pools (several base URLs) are for "
+                "OpenAI-compatible servers (openai:<model>@<url>,<url>)"
+            )
+        self.base_url = given or None
         if self.base_url is not None:
             self.base_url = check_base_url(self.base_url, f"gemini:{model}")
             register_url_secret(self.base_url)
@@ -141,6 +147,7 @@ class GeminiBackend(BaseBackend):
             completion_tokens=completion,
             image_tokens=image_tokens,
             source="reported",
+            cached_prompt_tokens=_cached_count(meta),
         )
 
     def _classify(self, exc: BaseException) -> ErrorInfo | None:
@@ -195,6 +202,15 @@ class GeminiBackend(BaseBackend):
                 ErrorKind.fatal, f"not found (HTTP 404): is the model name right? {detail}"
             )
         return ErrorInfo(ErrorKind.fatal, f"request rejected (HTTP {code}): {detail}")
+
+
+def _cached_count(meta: Any) -> int:
+    """`usage_metadata.cached_content_token_count` (implicit or explicit context caching),
+    bounded by the prompt; 0 when absent or not a count."""
+    cached = getattr(meta, "cached_content_token_count", None)
+    if not isinstance(cached, int) or isinstance(cached, bool) or cached < 0:
+        return 0
+    return min(cached, meta.prompt_token_count)
 
 
 def _finish_reason(response: Any) -> str | None:

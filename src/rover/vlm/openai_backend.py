@@ -17,7 +17,8 @@ from rover.vlm.base import BaseBackend, RawAnswer
 from rover.vlm.config import BackendConfig
 from rover.vlm.endpoint import check_base_url, endpoint_identity
 from rover.vlm.keys import install_log_scrubbing, read_key, register_url_secret
-from rover.vlm.retry import ErrorInfo, ErrorKind, MalformedReply, parse_retry_after
+from rover.vlm.pool import EndpointPool, Replica, split_urls
+from rover.vlm.retry import ErrorInfo, ErrorKind, MalformedReply, RetryPolicy, parse_retry_after
 from rover.vlm.scrub import scrub_line
 from rover.vlm.tokens import estimate_prompt_tokens
 from rover.vlm.types import ImagePart, Message, Prompt, SamplingParams, TextPart, Usage
@@ -82,10 +83,17 @@ class OpenAIBackend(BaseBackend):
             ) from exc
         install_log_scrubbing()
         # OPENAI_BASE_URL is the SDK's own override; honour it here too so the key rule matches
-        self.base_url = base_url or self.config.base_url or os.environ.get("OPENAI_BASE_URL")
-        if self.base_url is not None:
-            self.base_url = check_base_url(self.base_url, f"openai:{model}")
-            register_url_secret(self.base_url)
+        urls = split_urls(base_url or self.config.base_url or os.environ.get("OPENAI_BASE_URL"))
+        # several URLs: replicas of one model, routed and failed over by the pool
+        self.pool: EndpointPool | None = None
+        self.base_url: str | None = None
+        if len(urls) > 1:
+            self.pool = EndpointPool(urls, f"openai:{model}", self.config.pool_cooldown_s)
+            self.base_url = self.pool.replicas[0].url
+        elif urls:
+            self.base_url = check_base_url(urls[0], f"openai:{model}")
+        for url in urls:
+            register_url_secret(url)
         env = self.config.api_key_env or DEFAULT_KEY_ENV
         key, _ = read_key(env)
         if key is None:
@@ -105,15 +113,34 @@ class OpenAIBackend(BaseBackend):
     @property
     def where(self) -> str:
         """The server, as shown in messages (credentials removed)."""
+        if self.pool is not None:
+            return f"every replica of the pool ({self.pool.describe()})"
         return endpoint_identity(self.base_url) if self.base_url else "api.openai.com"
 
     def cache_extra(self) -> dict[str, Any]:
         return {"detail": self.config.detail}
 
     def endpoint(self) -> str:
+        if self.pool is not None:  # one deployment, whichever replica answers
+            return self.pool.identity
         return endpoint_identity(self.base_url or "https://api.openai.com/v1")
 
-    def _client(self) -> Any:
+    def _retry_policy(self) -> RetryPolicy:
+        policy = super()._retry_policy()
+        if self.pool is None:
+            return policy
+        # the pool times each replica's attempt itself, so a failover gets a fresh timeout
+        return RetryPolicy(
+            max_retries=policy.max_retries,
+            timeout_s=None,
+            base_wait_s=policy.base_wait_s,
+            max_wait_s=policy.max_wait_s,
+            timeout_retries=policy.timeout_retries,
+        )
+
+    def _client(self, base_url: str | None = None) -> Any:
+        url = base_url or self.base_url
+
         def make() -> Any:
             import httpx
             from openai import AsyncOpenAI
@@ -121,14 +148,26 @@ class OpenAIBackend(BaseBackend):
             c = self.config
             return AsyncOpenAI(
                 api_key=self._key,
-                base_url=self.base_url,
+                base_url=url,
                 max_retries=0,
                 timeout=httpx.Timeout(c.timeout_s, connect=min(c.connect_timeout_s, c.timeout_s)),
             )
 
-        return self.loop_local("client", make)
+        name = "client" if url == self.base_url else f"client:{endpoint_identity(url or '')}"
+        return self.loop_local(name, make)
 
     async def _generate(self, prompt: Prompt, params: SamplingParams) -> RawAnswer:
+        if self.pool is None:
+            return await self._generate_at(None, prompt, params)
+
+        async def at(replica: Replica) -> RawAnswer:
+            return await self._generate_at(replica.url, prompt, params)
+
+        return await self.pool.call(at, self._classify_any, self.config.timeout_s)
+
+    async def _generate_at(
+        self, base_url: str | None, prompt: Prompt, params: SamplingParams
+    ) -> RawAnswer:
         kwargs: dict[str, Any] = {
             "model": self.model,
             "messages": to_openai_messages(prompt, self.config.detail),
@@ -140,7 +179,7 @@ class OpenAIBackend(BaseBackend):
             kwargs["temperature"] = params.temperature
         if params.seed is not None:
             kwargs["seed"] = params.seed
-        response = await self._client().chat.completions.create(**kwargs)
+        response = await self._client(base_url).chat.completions.create(**kwargs)
         text = _reply_text(response)
         finish = _finish_reason(response)
         return RawAnswer(
@@ -164,6 +203,7 @@ class OpenAIBackend(BaseBackend):
             completion_tokens=c if isinstance(c, int) and c >= 0 else 0,
             image_tokens=min(image_tokens, p),
             source="reported",
+            cached_prompt_tokens=_cached_tokens(reported, p),
         )
 
     def _classify(self, exc: BaseException) -> ErrorInfo | None:
@@ -217,6 +257,19 @@ class OpenAIBackend(BaseBackend):
                 f"not found (HTTP 404) at {self.where}: is the model name right? {detail}",
             )
         return ErrorInfo(ErrorKind.fatal, f"request rejected (HTTP {status}): {detail}")
+
+
+def _cached_tokens(reported: Any, prompt_tokens: int) -> int:
+    """`usage.prompt_tokens_details.cached_tokens` (OpenAI; vLLM and SGLang with prefix
+    caching on), bounded by the prompt; 0 when absent or not a count."""
+    details = getattr(reported, "prompt_tokens_details", None)
+    if isinstance(details, dict):  # an SDK that left an unknown shape as a plain dict
+        cached = details.get("cached_tokens")
+    else:
+        cached = getattr(details, "cached_tokens", None)
+    if not isinstance(cached, int) or isinstance(cached, bool) or cached < 0:
+        return 0
+    return min(cached, prompt_tokens)
 
 
 def _short_message(exc: Any) -> str:

@@ -46,6 +46,9 @@ class Reply:
         code: provider error code (e.g. "insufficient_quota").
         raw: send these exact bytes as the body instead (hostile or malformed replies).
         content_type: the content-type header sent with the body.
+        cached_tokens: prompt tokens to report as served from the provider's prefix cache
+            (OpenAI/vLLM `prompt_tokens_details.cached_tokens`, Gemini
+            `cachedContentTokenCount`); None = report no such field.
     """
 
     status: int = 200
@@ -56,6 +59,7 @@ class Reply:
     code: str | None = None
     raw: bytes | None = None
     content_type: str = "application/json"
+    cached_tokens: int | None = None
 
 
 class _LoopbackServer:
@@ -213,6 +217,8 @@ class OpenAICompatServer(_LoopbackServer):
                 else (40 + 100 * _count_images(body), len(text.split()))
             )
             out["usage"] = {"prompt_tokens": p, "completion_tokens": c, "total_tokens": p + c}
+            if reply.cached_tokens is not None:
+                out["usage"]["prompt_tokens_details"] = {"cached_tokens": reply.cached_tokens}
         return 200, out
 
 
@@ -268,4 +274,6 @@ class GeminiRESTServer(_LoopbackServer):
                 "totalTokenCount": p + c,
                 "promptTokensDetails": details,
             }
+            if reply.cached_tokens is not None:
+                out["usageMetadata"]["cachedContentTokenCount"] = reply.cached_tokens
         return 200, out
