@@ -127,10 +127,10 @@ class Rover(Method):
     async def run(self, episode: Episode, vlm: VLM, on_step: OnStep | None = None) -> Trace:
         vlm = vlm.bind(episode)
         s = Session(self, episode, vlm, on_step)  # all per-run state lives on s
-        return await self.reason(s, episode.task)
+        return self.stitched(s, await self.reason(s, episode.task))
 
-    async def reason(self, s: Session, task: str) -> Trace:
-        """ROVER over the frames `s` gives, then the stitched trace.
+    async def reason(self, s: Session, task: str) -> _Line:
+        """Algorithm 1 over the frames `s` gives; returns the ended root line.
 
         The one implementation for finished videos (`run`) and live streams
         (`rover.stream.RoverStream`, whose session waits for each pushed frame in
@@ -140,6 +140,10 @@ class Rover(Method):
         # ROVER(c, []) with c = task description + first observation (Sec. 3)
         root = self._new_line(s, task, [], 0, Seen(0, None, 0.0))
         await self._line(s, root)
+        return root
+
+    def stitched(self, s: Session, root: _Line) -> Trace:
+        """The finished trace: every frame's stitched full-task value, the line tree."""
         curve, sources = stitch(root.stitch, s.num_frames)
         for pos, fr in enumerate(s.trace.frames):
             fr.progress = curve[pos]
