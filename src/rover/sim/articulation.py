@@ -27,8 +27,13 @@ FINISH = 0.9  # "completely open/turned": at least this (the fixture's success t
 CLOSED_AT = 0.1  # "completely closed": drawer opening fraction at most this
 
 # end signals the fixtures answer: all mean "the fixture's joint reached its target"
-SIGNALS = ("drawer_opened", "drawer_closed", "pressed", "turned")
-PARTS = ("drawer", "button", "knob")  # articulated part (= task object) names
+SIGNALS = ("drawer_opened", "drawer_closed", "door_opened", "door_closed", "pressed", "turned")
+# articulated part (= task object) names; a kitchen "door" closed by its task is one too
+# (an opened door's events come from `rover.sim.facts`, as robosuite's Door's)
+PARTS = ("drawer", "button", "knob", "door", "stop button")
+# push buttons: fact 1.0 while pressed past the switching depth; "stop button" switches
+# its appliance off (the kitchen microwave's, push-to-latch), "button" switches it on
+BUTTONS = ("button", "stop button")
 
 
 def fixture(sim: SimEnv):
@@ -49,7 +54,12 @@ def predicate(sim: SimEnv, kind: str, obj: str) -> bool | None:
 
 def holdable(sim: SimEnv, name: str) -> bool:
     """Whether both fingers on this object mean the robot holds it (not a push button)."""
-    return name != "button"
+    return name not in BUTTONS
+
+
+def closing(spec: TaskSpec, name: str) -> bool:
+    """Whether the task closes part `name` (a drawer or door that starts open)."""
+    return any(s.end_signal == f"{name}_closed:{name}" for s in spec.subtasks)
 
 
 def goal(sim: SimEnv, g: GoalSpec) -> np.ndarray:
@@ -63,17 +73,18 @@ def goal(sim: SimEnv, g: GoalSpec) -> np.ndarray:
 def articulation_facts(sim: SimEnv) -> tuple[dict[str, float], list[str]]:
     """Articulation fractions of the fixture part and the parts pressed down now.
 
-    ``drawer``: opening fraction (0 closed, 1 fully open, also when closing it);
-    ``button``: 1.0 while pressed past the switching depth (the appliance is on), else 0.0;
+    ``drawer`` (and a kitchen ``door``): opening fraction (0 closed, 1 fully open, also
+    when closing it); ``button``: 1.0 while pressed past the switching depth (the
+    appliance is on), else 0.0; ``stop button``: the same (1.0: the appliance is off);
     ``knob``: fraction of the target turn.
     """
     fx = fixture(sim)
     if fx is None:
         return {}, []
-    pressed = [fx.part] if fx.part == "button" and fx.pressed() else []
-    if fx.part == "drawer":
+    pressed = [fx.part] if fx.part in BUTTONS and fx.pressed() else []
+    if fx.part in ("drawer", "door"):
         value = fx.opening()
-    elif fx.part == "button":  # on/off: a half-pressed button has not switched anything
+    elif fx.part in BUTTONS:  # on/off: a half-pressed button has not switched anything
         value = 1.0 if pressed else 0.0
     else:
         value = fx.progress()
@@ -90,8 +101,9 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
     """Events of an articulated part, the first frame at which the facts show each.
 
     drawer: grasp, open_start/open_finish (or close_start/close_finish when the task
-    closes it); button: press and turn_on (the appliance switches on as the button
-    bottoms out); knob: grasp, turn_start, turn_finish.
+    closes it, as for a kitchen door that starts open); button: press and turn_on (the
+    appliance switches on as the button bottoms out), stop button: press and turn_off;
+    knob: grasp, turn_start, turn_finish.
     """
 
     def value(f: FrameFacts) -> float:
@@ -103,7 +115,7 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
     signals = {s.end_signal.partition(":")[0] for s in spec.subtasks}
     # a grasp, as for free objects: a hold begins (both fingers on it, moving with the hand)
     grasp = ev("grasp", _first(facts, lambda f: f.holding == name))
-    if name == "drawer" and "drawer_closed" in signals:
+    if name in ("drawer", "door") and f"{name}_closed" in signals:
         return [
             grasp,
             ev("close_start", _first(facts, lambda f: value(f) < FINISH)),
@@ -115,9 +127,9 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
             ev("open_start", _first(facts, lambda f: value(f) > START)),
             ev("open_finish", _first(facts, lambda f: value(f) >= FINISH)),
         ]
-    if name == "button":
+    if name in BUTTONS:
         press = _first(facts, lambda f: name in f.pressed)
-        return [ev("press", press), ev("turn_on", press)]
+        return [ev("press", press), ev("turn_off" if name == "stop button" else "turn_on", press)]
     if name == "knob":
         return [
             grasp,

@@ -70,8 +70,8 @@ def button_script(sim: SimEnv) -> list[Phase]:
     """Close the fingers above the button, press it down and hold it there."""
     fx = sim.env
 
-    def top() -> np.ndarray:
-        return sim.point("button:top")
+    def top() -> np.ndarray:  # the task's button ("button", a kitchen "stop button")
+        return sim.point(f"{fx.part}:top")
 
     def pressed_point() -> np.ndarray:  # a little below the switching depth
         return fx.site_at("top", fx.target * 1.3) + np.array([0.0, 0.0, -0.004])

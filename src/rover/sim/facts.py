@@ -250,7 +250,7 @@ def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
             events.append(Event(name="drop", object=name, frame=drop))
             if spec.bins or "on" in spec.goals or "peg" in spec.goals:
                 events.append(Event(name="place", object=name, frame=place))
-        elif name == "door":
+        elif name == "door" and not articulation.closing(spec, name):
             events.append(
                 Event(name="grasp", object=name, frame=_first(facts, lambda f: f.holding == "door"))
             )

@@ -96,8 +96,11 @@ class RoverKitchen(FixtureEnv):
         self.table_full_size = COUNTER_SIZE
 
     def opening(self) -> float:
-        """Drawer: how far open, 0 closed, 1 pulled out `OPEN_Q` or more (as the tabletop's)."""
-        return float(np.clip(self.joint_value() / OPEN_Q, 0.0, 1.0))
+        """How far open, 0 closed: a drawer 1 pulled out `OPEN_Q` or more (as the
+        tabletop's); a hinged door 1 at the open end of its task's swing (the target when
+        opening it, the start when closing it), so "x% open" reads the same both ways."""
+        full = OPEN_Q if self.kind == "drawer" else max(self.start_q, self.target)
+        return float(np.clip(self.joint_value() / full, 0.0, 1.0))
 
     def pressed(self) -> bool:
         """Button: pushed down past the switching depth (the appliance is on)."""

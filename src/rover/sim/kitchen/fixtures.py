@@ -79,7 +79,7 @@ FIXTURES: dict[str, Fixture] = {
             (0.07, 0.12),
             (-0.2, -0.02),
             (-0.2, 0.2),
-            {"button": "button", "door": "door"},
+            {"button": "button", "door": "door", "stop": "stop"},
         ),
         Fixture(
             "Coffee",

@@ -22,10 +22,20 @@ PARAPHRASES: dict[str, list[str]] = {
         "Swing the cabinet door open.",
         "Grab the cabinet's handle and open its door.",
     ],
+    "CloseSingleDoor": [
+        "Push the open cabinet door shut.",
+        "Swing the cabinet door closed by its handle.",
+        "Close the cabinet door.",
+    ],
     "TurnOnMicrowave": [
         "Turn the microwave on with its start button.",
         "Push the microwave's start button.",
         "Start the microwave.",
+    ],
+    "TurnOffMicrowave": [
+        "Turn the running microwave off with its stop button.",
+        "Push the microwave's red stop button.",
+        "Stop the microwave.",
     ],
     "CoffeePressButton": [
         "Push the button on top of the coffee machine.",

@@ -127,6 +127,32 @@ OPEN_SINGLE_DOOR = _spec(
 
 
 # ----------------------------------------------------------- appliances on/off
+def _close_single_door() -> TaskSpec:
+    """The cabinet door starts swung open `DOOR_OPEN` and is pushed shut: the drawer
+    protocol with "door" (facts: the door's opening fraction; events close_start,
+    close_finish), carried along its arc by the swing expert."""
+    proto = drawer_protocol(closing=True, part="door")
+    proto.update(
+        description="Grasp the cabinet door's handle and swing the door closed.",
+        expert="kitchen_swing",
+        max_expert_steps=320,
+    )
+    return _spec(
+        "CloseSingleDoor",
+        # closed = at most 10% open (7 degrees): 92% of the way from DOOR_OPEN
+        env_kwargs={
+            "fixture": "Cabinet",
+            "part": "door",
+            "start_q": DOOR_OPEN,
+            "target": 0.0,
+            "reach": 0.92,
+        },
+        group="doors_drawers",
+        objects=[_part("door", "Cabinet", "door", "centre", handle="handle")],
+        **proto,
+    )
+
+
 def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
     return _spec(
         name,
@@ -173,6 +199,59 @@ def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
 
 
 # ---------------------------------------------------------- fixtures and knobs
+TURN_OFF_MICROWAVE = _spec(
+    "TurnOffMicrowave",
+    # the microwave runs at the start; its red stop button latches down when pressed
+    env_kwargs={
+        "fixture": "Microwave",
+        "part": "stop",
+        "facts_as": "stop button",
+        "target": PRESS_Q / 0.9,
+    },
+    description="Press the stop button of the microwave to turn it off.",
+    group="appliances",
+    objects=[_part("stop button", "Microwave", "stop", "stop_top", top="stop_top")],
+    goals={"button_pressed": GoalSpec(kind="fixture", object="stop button", body="stop_top")},
+    subtasks=[
+        _reach(
+            "reach the microwave's stop button",
+            "stop button",
+            "stop button:top",
+            "touched:stop button",
+        ),
+        _move(
+            "press the stop button down",
+            "stop button",
+            "stop button:top",
+            "goal:button_pressed",
+            "pressed:stop button",
+        ),
+    ],
+    levels=named_levels(
+        [[], []],
+        [
+            "Fail to approach the on/off button",
+            "Approach the on/off button",
+            "Press the button and turn the microwave off",
+        ],
+    ),
+    milestones=["approach:stop button", "press:stop button"],
+    qa_templates=_qa(
+        "stop button",
+        [
+            (
+                "did_press",
+                "Did the robot press the stop button of the microwave? If so, when?",
+                "press",
+            ),
+            ("did_turn_off", "Did the robot turn the microwave off? If so, when?", "turn_off"),
+        ],
+    ),
+    expert="button",
+    max_expert_steps=200,
+)
+
+
 def _early_start(milestones: list[list[str]], names: list[str]) -> list:
     """Table-5 levels whose "start turning" video stops early in the turn (20-35% of its
     expert steps, not around half): a dial turns fast, and random wrist motions from a
@@ -252,7 +331,9 @@ TASKS: list[TaskSpec] = [
     _drawer(closing=True),
     OPEN_SINGLE_DOOR,
     _button("TurnOnMicrowave", "Microwave", "microwave"),
+    _close_single_door(),
     _button("CoffeePressButton", "Coffee", "coffee machine"),
+    TURN_OFF_MICROWAVE,
     _dial("TurnOnStove", "Stove", "stove knob", "stove", on=True),
     _dial("TurnOffStove", "Stove", "stove knob", "stove", on=False),
     _dial("TurnOnSinkFaucet", "Sink", "sink handle", "sink", on=True, tip="handle_tip"),

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from rover.sim.levels import by_milestone
 from rover.sim.tasks._common import FINGERS, named_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
@@ -29,67 +30,74 @@ def _qa(items: list[tuple[str, str, str]], obj: str) -> list[QATemplate]:
     return [QATemplate(id=i, text=t, event=e, object=obj) for i, t, e in items]
 
 
-def drawer_protocol(closing: bool) -> dict[str, Any]:
+def drawer_protocol(closing: bool, part: str = "drawer") -> dict[str, Any]:
     """A drawer task wherever the drawer stands: its sentence, goal, subtasks, Table 5
     levels and milestones, App. C.3 questions and expert. The tabletop and kitchen suites
-    differ only in the environment around the drawer, so both build from this."""
-    verb, signal = ("close", "drawer_closed") if closing else ("open", "drawer_opened")
+    differ only in the environment around the drawer, so both build from this. `part`
+    "door" gives a hinged door's (the kitchen's CloseSingleDoor): the same sentence,
+    subtasks, levels and questions with "door", end signals ``door_closed`` /
+    ``door_opened``; the caller sets the door's expert."""
+    verb, signal = ("close", f"{part}_closed") if closing else ("open", f"{part}_opened")
     ing = "closing" if closing else "opening"
     push, end = ("push", "closed") if closing else ("pull", "open")
     return {
-        "description": f"Grasp the drawer handle and {push} the drawer {end}.",
-        "goals": {f"drawer_{verb}": GoalSpec(kind="fixture", object="drawer", body="handle")},
+        "description": f"Grasp the {part} handle and {push} the {part} {end}.",
+        "goals": {f"{part}_{verb}": GoalSpec(kind="fixture", object=part, body="handle")},
         "subtasks": [
             SubtaskSpec(
-                name="grasp the drawer handle",
-                object="drawer",
+                name=f"grasp the {part} handle",
+                object=part,
                 robot_points=FINGERS,
-                object_points=["drawer:handle", "drawer:handle"],
-                end_signal="grasped:drawer",
+                object_points=[f"{part}:handle", f"{part}:handle"],
+                end_signal=f"grasped:{part}",
             ),
             SubtaskSpec(
-                name=f"{push} the drawer {end}",
-                object="drawer",
+                name=f"{push} the {part} {end}",
+                object=part,
                 robot_points=FINGERS,
-                object_points=["drawer:handle", "drawer:handle"],
-                goal=f"goal:drawer_{verb}",
-                joint="joint:drawer",
+                object_points=[f"{part}:handle", f"{part}:handle"],
+                goal=f"goal:{part}_{verb}",
+                joint=f"joint:{part}",
                 beta=0.8,
-                end_signal=f"{signal}:drawer",
+                end_signal=f"{signal}:{part}",
             ),
         ],
         "levels": named_levels(
-            [["Approach the drawer"], [f"Start {ing} the drawer"]],
+            [[f"Approach the {part}"], [f"Start {ing} the {part}"]],
             [
-                "Fail to approach the drawer",
-                "Approach the drawer",
-                "Contact the drawer",
-                f"Start {ing} the drawer",
-                f"Finish {ing} the drawer",
+                f"Fail to approach the {part}",
+                f"Approach the {part}",
+                f"Contact the {part}",
+                f"Start {ing} the {part}",
+                f"Finish {ing} the {part}",
             ],
         ),
         "milestones": [
-            "approach:drawer",
-            "contact:drawer",
-            f"{verb}_start:drawer",
-            f"{verb}_finish:drawer",
+            f"approach:{part}",
+            f"contact:{part}",
+            f"{verb}_start:{part}",
+            f"{verb}_finish:{part}",
         ],
         "qa_templates": _qa(
             [
-                ("did_contact", "Did the robot contact the drawer handle? If so, when?", "contact"),
-                ("did_grasp", "Did the robot grasp the drawer handle? If so, when?", "grasp"),
+                (
+                    "did_contact",
+                    f"Did the robot contact the {part} handle? If so, when?",
+                    "contact",
+                ),
+                ("did_grasp", f"Did the robot grasp the {part} handle? If so, when?", "grasp"),
                 (
                     f"did_{verb}_start",
-                    f"Did the robot start {ing} the drawer? If so, when?",
+                    f"Did the robot start {ing} the {part}? If so, when?",
                     f"{verb}_start",
                 ),
                 (
                     f"did_{verb}_finish",
-                    f"Did the robot completely {verb} the drawer? If so, when?",
+                    f"Did the robot completely {verb} the {part}? If so, when?",
                     f"{verb}_finish",
                 ),
             ],
-            "drawer",
+            part,
         ),
         "expert": "drawer_close" if closing else "drawer_open",
         "max_expert_steps": 300,
@@ -226,6 +234,12 @@ TURN_KNOB = TaskSpec(
     ),
     expert="knob",
     max_expert_steps=250,
+)
+
+# the tabletop tasks' levels leave the expert by milestone (`rover.sim.levels.by_milestone`)
+OPEN_DRAWER, PRESS_BUTTON, TURN_KNOB, CLOSE_DRAWER = (
+    t.model_copy(update={"levels": by_milestone(t.levels, t.milestones)})
+    for t in (OPEN_DRAWER, PRESS_BUTTON, TURN_KNOB, CLOSE_DRAWER)
 )
 
 # every articulated task; the registry takes those whose expert passed the 90% bar
