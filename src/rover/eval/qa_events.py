@@ -205,8 +205,8 @@ def _event_here(ev: str, obj: str, target: str | None, a: Asserted, was_held: bo
         pressed = _get(a.pressed, obj)
         if pressed is None and obj != "button":
             pressed = _get(a.pressed, "button")
-        if pressed is not None:
-            return pressed is (ev == "turn_on")
+        if pressed is not None:  # a pressed stop button (the kitchen microwave's) is "off"
+            return pressed is (ev == ("turn_off" if obj == "stop button" else "turn_on"))
     rng = _get(a.parts, obj)
     if not isinstance(rng, tuple):
         return False

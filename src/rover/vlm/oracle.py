@@ -91,12 +91,12 @@ def describe(facts: FrameFacts | None, flip_prob: float = 0.0, rng=None) -> str:
         elif obj.on:
             out.append(f"{thing} is lifted." if flip() else f"{thing} is on {_the(obj.on)}.")
     for part, frac in facts.articulations.items():
-        if part == "button" or part in facts.pressed:
+        if part in ("button", "stop button") or part in facts.pressed:  # on/off, said below
             continue
         if flip():
             frac = 1.0 - frac
         out.append(f"{_the(part).capitalize()} is {round(100 * frac)}% open.")
-    for part in sorted(set(facts.pressed) | ({"button"} & set(facts.articulations))):
+    for part in sorted(set(facts.pressed) | ({"button", "stop button"} & set(facts.articulations))):
         pressed = part in facts.pressed or facts.articulations.get(part, 0.0) >= 0.5
         if flip():
             pressed = not pressed
