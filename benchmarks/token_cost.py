@@ -13,7 +13,16 @@ Targets checked (App. G): ROVER <= 1/3 of GVL's tokens at 30 frames, <= 1/5 at 6
 <= 1/15 at 240; ROVER tokens(240) / tokens(30) <= 9 (linear scaling); calls per video
 <= 1.25 x frames; framework overhead <= 5 ms per call.
 
-A second table times reply parsing on 100 KB of adversarial and realistic text (issue 15:
+A second table (issue 14) shows how much of each method's prompt tokens repeat an earlier
+call's prompt of the same video as a prefix — what a prompt-prefix cache can serve —
+measured from the request messages as sent (`rover.vlm.prefix`): the ideal share, and
+what vLLM's automatic prefix caching (whole 16-token blocks) and OpenAI's prompt caching
+(from 1,024 tokens, in steps of 128) can reuse of it. Its cached / uncached columns come
+from the trace's totals and the cost rows, as in a real run, with a stand-in provider
+that reports the vLLM-cacheable part as `cached_tokens`. Target: ROVER's repeated-prefix
+share >= 40% at 30 frames.
+
+A third table times reply parsing on 100 KB of adversarial and realistic text (issue 15:
 parsing must be linear in reply length): `parse_step` under 50 ms on every input.
 """
 
@@ -30,11 +39,13 @@ from pathlib import Path
 import numpy as np
 
 from rover.episode import Episode, Event, FrameFacts, GroundTruth, ObjectFacts, StateType, Subtask
+from rover.eval.cost import cost_row
 from rover.methods import get_method
 from rover.methods.parse import parse_frames, parse_step
 from rover.methods.registry import NON_VLM_METHODS, method_names
 from rover.vlm.config import BackendConfig
 from rover.vlm.oracle import OracleBackend
+from rover.vlm.prefix import PrefixTracker, openai_cached, vllm_cached
 
 SIZE = 256
 
@@ -103,15 +114,56 @@ class TimedVLM:
             self.backend_s += time.perf_counter() - t0
 
 
+class PrefixCacheVLM:
+    """Stands in for a provider with a prompt-prefix cache: measures each prompt's repeated
+    prefix (one tracker per video) and reports vLLM's cacheable part as cached tokens."""
+
+    def __init__(self, inner, tracker: PrefixTracker | None = None) -> None:
+        self.inner = inner
+        self.backend, self.model = inner.backend, inner.model
+        self.image_encoding = getattr(inner, "image_encoding", None)
+        self.tracker = tracker or PrefixTracker("gemini")
+        self.openai_tokens = 0
+
+    def bind(self, episode: Episode) -> PrefixCacheVLM:
+        bound = PrefixCacheVLM(self.inner.bind(episode), PrefixTracker(self.tracker.rule))
+        self._bound = bound
+        return bound
+
+    async def complete(self, prompt, params=None):
+        repeated, _ = self.tracker.add(prompt)
+        self.openai_tokens += openai_cached(repeated)
+        out = await self.inner.complete(prompt, params)
+        cached = min(vllm_cached(repeated), out.usage.prompt_tokens)
+        usage = out.usage.model_copy(update={"cached_prompt_tokens": cached})
+        return out.model_copy(update={"usage": usage})
+
+
 def measure(method: str, n: int) -> dict:
     ep = synthetic_episode(n)
-    vlm = TimedVLM(OracleBackend(BackendConfig(no_cache=True)))
+    cache = PrefixCacheVLM(OracleBackend(BackendConfig(no_cache=True)))
+    vlm = TimedVLM(cache)
     m = get_method(method, concurrency=1)
     t0 = time.perf_counter()
     trace = asyncio.run(m.run(ep, vlm))
     wall = time.perf_counter() - t0
     backend_s = vlm._bound.backend_s
     t = trace.totals
+    tracker = cache._bound.tracker
+    cost = cost_row(trace)
+    prefix = {
+        "prefix_prompt_tokens": tracker.prompt_tokens,  # as measured from the messages
+        "repeated_prefix_tokens": tracker.repeated_tokens,
+        "repeated_share": round(tracker.share, 4),
+        "vllm_cacheable_share": round(
+            cost["cached_prompt_tokens"] / max(tracker.prompt_tokens, 1), 4
+        ),
+        "openai_cacheable_share": round(
+            cache._bound.openai_tokens / max(tracker.prompt_tokens, 1), 4
+        ),
+        "cached_prompt_tokens": cost["cached_prompt_tokens"],
+        "uncached_prompt_tokens": cost["uncached_prompt_tokens"],
+    }
     return {
         "method": method,
         "frames": n,
@@ -121,7 +173,22 @@ def measure(method: str, n: int) -> dict:
         "calls": t.calls,
         "wall_s": round(wall, 3),
         "overhead_ms_per_call": round(1000 * (wall - backend_s) / max(t.calls, 1), 3),
+        **prefix,
     }
+
+
+def print_prefix_rows(rows: list[dict]) -> None:
+    print(
+        f"\n{'repeated prefix':<20}{'frames':>7}{'prompt':>12}{'repeated':>12}{'share':>8}"
+        f"{'vLLM':>7}{'OpenAI':>8}{'cached':>12}{'uncached':>12}"
+    )
+    for r in rows:
+        print(
+            f"{r['method']:<20}{r['frames']:>7}{r['prefix_prompt_tokens']:>12,}"
+            f"{r['repeated_prefix_tokens']:>12,}{r['repeated_share']:>8.1%}"
+            f"{r['vllm_cacheable_share']:>7.1%}{r['openai_cacheable_share']:>8.1%}"
+            f"{r['cached_prompt_tokens']:>12,}{r['uncached_prompt_tokens']:>12,}"
+        )
 
 
 PARSE_BYTES = 100_000
@@ -193,6 +260,10 @@ def check_targets(rows: list[dict]) -> list[tuple[str, float, float, bool]]:
         if r["method"].startswith("rover"):
             per = r["calls"] / r["frames"]
             out.append((f"{r['method']} calls/frame at {r['frames']}", per, 1.25, per <= 1.25))
+    for r in rows:
+        if r["method"] == "rover" and r["frames"] == 30:
+            share = r["repeated_share"]
+            out.append(("ROVER repeated-prefix share at 30 frames", share, 0.40, share >= 0.40))
     worst = max((r["overhead_ms_per_call"] for r in rows if r["method"] == "rover"), default=0)
     out.append(("ROVER framework overhead ms/call (worst)", worst, 5.0, worst <= 5.0))
     return out
@@ -227,6 +298,7 @@ def main(argv: list[str] | None = None) -> int:
                 f"{r['wall_s']:>8.2f}",
                 flush=True,
             )
+    print_prefix_rows(rows)
     prows = parse_rows()
     print_parse_rows(prows)
     targets = check_targets(rows)
