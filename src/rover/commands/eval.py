@@ -81,6 +81,16 @@ def eval_command(
             "--calls-in-flight", help="VLM calls in flight per backend (default: --concurrency)."
         ),
     ] = None,
+    executor: Annotated[
+        str, typer.Option("--executor", help="Where work units run: 'local' or 'ray'.")
+    ] = "local",
+    ray_address: Annotated[
+        str | None,
+        typer.Option(
+            "--ray-address",
+            help="--executor ray: 'auto' or host:port of a running cluster (default: a local Ray).",
+        ),
+    ] = None,
     limit: Annotated[int | None, typer.Option("--limit", help="Only the first N episodes.")] = None,
     episodes: Annotated[
         int | None,
@@ -142,8 +152,12 @@ def eval_command(
     """Evaluate reasoning methods on a dataset: progress, frame reasoning, video QA, cost."""
     from rover.eval.runner import EvalOptions, finish_run, prepare_run
     from rover.eval.variants import parse_int_list, parse_name_list, split_backend_specs
+    from rover.exec import check_executor, key_env_names, make_executor
     from rover.io.source import spec_with_options
 
+    check_executor(executor, ray_address)  # a missing extra: one line, before any work
+    if executor == "ray" and record is not None:
+        raise InputError("--record writes one cassette in this process: use --executor local")
     if concurrency < 1:
         raise InputError(f"--concurrency must be at least 1, got {concurrency}")
     if calls_in_flight is not None and calls_in_flight < 1:  # 0 is not "unset"
@@ -229,8 +243,9 @@ def eval_command(
             info=info,
         )
 
-    runner = prepare_run(opts, on_update)
-    with progress:
+    ex = make_executor(executor, address=ray_address, env_keys=key_env_names(config))
+    runner = prepare_run(opts, on_update, executor=ex)
+    with ex, progress:
         state, metrics = asyncio.run(finish_run(runner))
     _print_main_table(metrics, oracle="oracle" in opts.backends)
     out_console = make_console()

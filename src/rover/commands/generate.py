@@ -33,6 +33,16 @@ def generate_command(
     size: Annotated[int, typer.Option(help="Frame width and height in px.")] = 256,
     seed: Annotated[int, typer.Option(help="Seed: same seed, same dataset.")] = 0,
     workers: Annotated[int, typer.Option(help="Parallel worker processes.")] = 1,
+    executor: Annotated[
+        str, typer.Option("--executor", help="Where episodes run: 'local' (--workers) or 'ray'.")
+    ] = "local",
+    ray_address: Annotated[
+        str | None,
+        typer.Option(
+            "--ray-address",
+            help="--executor ray: 'auto' or host:port of a running cluster (default: a local Ray).",
+        ),
+    ] = None,
     demos: Annotated[int, typer.Option(help="Expert demonstrations per task.")] = 3,
     source_hdf5: Annotated[
         Path | None,
@@ -47,10 +57,12 @@ def generate_command(
     ] = "rover",
 ) -> None:
     """Generate perturbed robosuite videos with ground-truth progress, facts, events and QA."""
+    from rover.exec import check_executor, make_executor
     from rover.sim.generate import MAX_FRAMES, GenerateConfig, generate
     from rover.sim.render import check_views
     from rover.sim.tasks import get_task
 
+    check_executor(executor, ray_address)  # a missing extra: one line, before any work
     task_list = _split(tasks)
     if not task_list:
         raise InputError("--tasks is empty")
@@ -106,7 +118,8 @@ def generate_command(
                 )
             bar.update(ids[stage], completed=done, total=total)
 
-        written = generate(cfg, out, workers=workers, on_progress=on_progress)
+        ex = make_executor(executor, workers=workers, address=ray_address)
+        written = generate(cfg, out, workers=workers, on_progress=on_progress, executor=ex)
     took = time.perf_counter() - start
     console.print(f"wrote {len(written)} episodes to {esc(out)} in {took:.1f}s")
     from rover.commands.validate import run_audit

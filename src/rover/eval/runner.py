@@ -153,8 +153,17 @@ class Runner:
         variants: list[Variant],
         on_update: OnUpdate | None = None,
         vlms: dict[str, Any] | None = None,
+        executor: Any = None,
     ) -> None:
         self.opts = opts
+        # rover.exec: None or a local one runs units here; a remote one (Ray) elsewhere
+        self.executor = executor
+        self.remote = bool(getattr(executor, "remote", False))
+        if self.remote and vlms:
+            raise InputError(
+                "ready VLM objects run in this process only: load backends by spec for a "
+                "remote executor, or use executor local"
+            )
         self.rundir = RunDir(opts.out)
         self.config = config
         self.refs = refs
@@ -239,7 +248,12 @@ class Runner:
                 self.state.episodes_done += 1
                 self.on_update(self.state)
                 return
-            await asyncio.gather(*(self._unit(ref, meta, loaded, v) for v in pending))
+            if self.remote:  # every unit of this episode as a task; results written here
+                from rover.exec.eval_unit import remote_units
+
+                await remote_units(self, ref, meta, loaded, pending)
+            else:
+                await asyncio.gather(*(self._unit(ref, meta, loaded, v) for v in pending))
         self.state.episodes_done += 1
         self.on_update(self.state)
 
@@ -266,7 +280,7 @@ class Runner:
         total = sum(len(arr) for arr in loaded.views.values()) * len(encodings)
         # the memo holds a few thousand images: pre-encode only what fits for every episode
         # in flight, else later episodes would evict earlier ones' frames before use
-        if total <= PRE_ENCODE_BUDGET // max(1, self.opts.concurrency):
+        if not self.remote and total <= PRE_ENCODE_BUDGET // max(1, self.opts.concurrency):
             for arr in loaded.views.values():
                 for enc in encodings.values():
                     for frame in arr:
@@ -274,13 +288,10 @@ class Runner:
         return meta, loaded
 
     async def _fail(self, ref: EpisodeRef, v: Variant, stage: str, exc: BaseException) -> None:
-        msg = str(exc) if isinstance(exc, RoverError) else f"{type(exc).__name__}: {exc}"
-        if not isinstance(exc, RoverError):
-            tb = traceback.format_exception(exc)
-            msg += " | " + "".join(tb[-3:]).strip().replace("\n", " | ")[-600:]
-        from rover.vlm.keys import scrub
+        await self.record_failure(ref, v, stage, failure_message(exc))
 
-        msg = scrub(msg)
+    async def record_failure(self, ref: EpisodeRef, v: Variant, stage: str, msg: str) -> None:
+        """Record a failed unit (`msg` already scrubbed): errors/, units.jsonl, counters."""
         await asyncio.to_thread(self.rundir.record_error, ref.id, v.id, stage, msg)
         self.rundir.log_unit(ref.id, v.id, stage, "error", error=msg[:300])
         self.state.errors += 1
@@ -373,6 +384,17 @@ class Runner:
         self.rundir.log_unit(ref.id, v.id, stage, "done", calls=result.calls)
 
 
+def failure_message(exc: BaseException) -> str:
+    """One scrubbed line for a failed unit: the message, plus a traceback tail for bugs."""
+    msg = str(exc) if isinstance(exc, RoverError) else f"{type(exc).__name__}: {exc}"
+    if not isinstance(exc, RoverError):
+        tb = traceback.format_exception(exc)
+        msg += " | " + "".join(tb[-3:]).strip().replace("\n", " | ")[-600:]
+    from rover.vlm.keys import scrub
+
+    return scrub(msg)
+
+
 def method_params(opts: EvalOptions) -> dict[str, dict[str, Any]]:
     """Fixed per-method parameters from the options (clip-value's local model)."""
     if opts.model_path is None:
@@ -387,12 +409,16 @@ def build_variants(opts: EvalOptions) -> list[Variant]:
 
 
 def prepare_run(
-    opts: EvalOptions, on_update: OnUpdate | None = None, vlms: dict[str, Any] | None = None
+    opts: EvalOptions,
+    on_update: OnUpdate | None = None,
+    vlms: dict[str, Any] | None = None,
+    executor: Any = None,
 ) -> Runner:
     """Check every input, load the backends and set up the run directory (no VLM calls).
 
     `vlms` maps backend specs to ready VLM objects, for library users with their own VLM
     class (anything with `complete` and `bind`); other specs go through `load_vlm`.
+    `executor` (see `rover.exec`) runs the work units; None: on this process's event loop.
 
     Raises:
         InputError: unknown method, bad sweep value, missing dataset, non-empty --out...
@@ -416,7 +442,7 @@ def prepare_run(
     _warm_up()
     config = run_config(opts, variants, refs)
     # backends load before anything is written, so a bad spec leaves no half-made run dir
-    runner = Runner(opts, config, refs, variants, on_update, vlms)
+    runner = Runner(opts, config, refs, variants, on_update, vlms, executor)
     RunDir(opts.out).prepare(config, opts.resume)
     return runner
 
@@ -431,7 +457,9 @@ async def finish_run(runner: Runner) -> tuple[RunState, dict]:
     return state, metrics
 
 
-async def run_eval(opts: EvalOptions, on_update: OnUpdate | None = None) -> tuple[RunState, dict]:
+async def run_eval(
+    opts: EvalOptions, on_update: OnUpdate | None = None, executor: Any = None
+) -> tuple[RunState, dict]:
     """Run (or resume) an evaluation; returns the final counters and metrics.json's data."""
-    runner = await asyncio.to_thread(prepare_run, opts, on_update)
+    runner = await asyncio.to_thread(prepare_run, opts, on_update, None, executor)
     return await finish_run(runner)

@@ -13,11 +13,10 @@ from __future__ import annotations
 
 import atexit
 import logging
-import multiprocessing as mp
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import BaseModel
@@ -312,25 +311,18 @@ def _worker_init() -> None:
     logging.getLogger("robosuite").setLevel(logging.ERROR)
 
 
-def _run_item(args: tuple[WorkItem, GenerateConfig, Path]) -> str:
-    return generate_episode(*args)
-
-
-def _run_demo(args: tuple[str, GenerateConfig, Path]) -> str:
-    make_demos(*args)
-    return args[0]
-
-
 def generate(
     cfg: GenerateConfig,
     out: Path,
     workers: int = 1,
     on_progress: Callable[[str, int, int], None] | None = None,
+    executor: Any = None,
 ) -> list[str]:
     """Generate (or finish) a dataset in `out`; returns the ids written by this call.
 
     Finished episodes already in `out` are kept; `.part` folders from an interrupted run
-    are redone. `on_progress(stage, done, total)` reports demos and episodes.
+    are redone. `on_progress(stage, done, total)` reports demos and episodes. `executor`
+    (see `rover.exec`) runs the demos and episodes; None: a local pool of `workers`.
     """
     from rover.sim.render import check_views
 
@@ -349,14 +341,24 @@ def generate(
     total = len(todo)
     written: list[str] = []
     report = on_progress or (lambda *_: None)
-    with _pool(workers) as pool:
-        tasks = sorted({it.task for it in todo})
-        for i, _ in enumerate(pool.imap_unordered(_run_demo, [(t, cfg, demo_dir) for t in tasks])):
-            report("demos", i + 1, len(tasks))
-        report("episodes", 0, total)
-        for eid in pool.imap_unordered(_run_item, [(it, cfg, out) for it in todo]):
-            written.append(eid)
-            report("episodes", len(written), total)
+    from rover.exec import LocalExecutor
+
+    ex = executor or LocalExecutor(workers, initializer=_worker_init)
+    with ex:
+        if not ex.shares_files:  # tasks on other nodes: they return bytes, we write them
+            from rover.exec.generate_job import generate_remote
+
+            written = generate_remote(ex, cfg, out, todo, report)
+        else:
+            tasks = sorted({it.task for it in todo})
+            for i, _ in enumerate(
+                ex.map_unordered(make_demos, [(t, cfg, demo_dir) for t in tasks])
+            ):
+                report("demos", i + 1, len(tasks))
+            report("episodes", 0, total)
+            for eid in ex.map_unordered(generate_episode, [(it, cfg, out) for it in todo]):
+                written.append(eid)
+                report("episodes", len(written), total)
     write_dataset_info(
         out,
         DatasetInfo(
@@ -379,24 +381,3 @@ def tries_by_level(out: Path) -> dict[str, dict[str, list[int]]]:
         level = str(ep.truth.level if ep.truth is not None else 0)
         found.setdefault(task, {}).setdefault(level, []).append(int(ep.extra.get("tries", 1)))
     return found
-
-
-class _Serial:
-    """In-process stand-in for a pool (workers=1: no spawn cost, easy to debug)."""
-
-    def __enter__(self) -> _Serial:
-        _worker_init()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        return None
-
-    def imap_unordered(self, fn, items) -> Iterator:
-        return map(fn, items)
-
-
-def _pool(workers: int):
-    if workers <= 1:
-        return _Serial()
-    ctx = mp.get_context("spawn")
-    return ctx.Pool(workers, initializer=_worker_init, maxtasksperchild=None)
