@@ -9,6 +9,7 @@ import pytest
 
 from rover.eval.cost import cost_row, cost_table
 from rover.eval.summary import _cost_table as summary_cost_table
+from rover.eval.summary import prompt_cache_line
 from rover.methods import get_method
 from rover.vlm import load_vlm
 from rover.vlm.cache import ResponseCache
@@ -87,3 +88,9 @@ def test_a_method_run_records_them_and_every_cost_view_splits_them(
     cost = summary_cost_table(metrics)  # summary.md, the HTML report (run_tables) read this
     assert cost.headers[3:5] == ["Cached prompt tokens", "Uncached prompt tokens"]
     assert cost.rows[0][3:5] == ["1,152", "848"]
+    # the terminal line after `rover eval`'s table reads the same rows
+    assert prompt_cache_line(metrics) == (
+        "prompt tokens served from the provider's prefix cache: TC 58%"
+    )
+    no_hits = [{**r, "cached_prompt_tokens": 0} for r in rows]
+    assert prompt_cache_line({**metrics, "cost": cost_table(no_hits)}) is None

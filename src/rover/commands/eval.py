@@ -278,7 +278,7 @@ def _print_main_table(metrics: dict, oracle: bool = False) -> None:
     numbers never cut (a long method name wraps instead); n goes into the title."""
     from rich import box
 
-    from rover.eval.summary import main_rows
+    from rover.eval.summary import main_rows, prompt_cache_line
 
     headers, rows = main_rows(metrics, compact=True)
     n = sorted({r[-1] for r in rows})
@@ -298,6 +298,9 @@ def _print_main_table(metrics: dict, oracle: bool = False) -> None:
     for r in rows:
         table.add_row(*(esc(cell) for cell in r[:-1]))  # method and backend names are data
     make_console().print(table)
+    cache_line = prompt_cache_line(metrics)  # read from the cost table, as summary.md is
+    if cache_line:
+        make_console().print(esc(cache_line), highlight=False, soft_wrap=True)
 
 
 def _short(n: int) -> str:

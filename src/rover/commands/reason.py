@@ -126,10 +126,11 @@ def _summary(console: Console, trace: Trace, out: Path) -> None:
     t = trace.totals
     final = trace.progress()[-1] if trace.frames else 0.0
     label = " [bold yellow]ORACLE[/] (answers from ground truth, not a VLM)" if trace.oracle else ""
+    cached = f"; {t.cached_prompt_tokens:,} of the prompt cached" if t.cached_prompt_tokens else ""
     console.print(
         f"[bold]{esc(trace.method)}[/] on {esc(trace.episode_id)}: {trace.num_frames} frames, "
         f"{t.calls} calls ({t.cached_calls} cached), {t.total_tokens:,} tokens "
-        f"({t.prompt_tokens:,} prompt + {t.completion_tokens:,} completion), "
+        f"({t.prompt_tokens:,} prompt + {t.completion_tokens:,} completion{cached}), "
         f"{t.parse_failures} parse failures, final progress {final:.0f}%{label}",
         highlight=False,
         soft_wrap=True,

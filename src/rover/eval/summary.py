@@ -380,6 +380,24 @@ def _cost_table(metrics: dict[str, Any]) -> Table | None:
     return Table("cost", "Inference cost (App. F)", headers, body, note=COST_NOTE)
 
 
+def prompt_cache_line(metrics: dict[str, Any]) -> str | None:
+    """One terminal line from the cost table: each method's share of prompt tokens the
+    provider served from its prefix cache; None when no provider reported any."""
+    labels = variant_names(metrics)
+    cells: dict[tuple, dict[str, Any]] = {}
+    for c in metrics.get("cost", []):
+        cells.setdefault((c["variant"], c["frames"]), {})[c["metric"]] = c["mean"]
+    parts = []
+    for (variant, frames), m in sorted(cells.items(), key=lambda kv: (str(kv[0][1]), kv[0][0])):
+        cached, prompt = m.get("cached_prompt_tokens"), m.get("prompt_tokens")
+        if cached and prompt:
+            at = f" at {frames} frames" if len({k[1] for k in cells}) > 1 else ""
+            parts.append(f"{labels.get(variant, variant)}{at} {100 * cached / prompt:.0f}%")
+    if not parts:
+        return None
+    return "prompt tokens served from the provider's prefix cache: " + ", ".join(parts)
+
+
 def _error_table(metrics: dict[str, Any]) -> Table | None:
     rows = metrics.get("error_analysis", [])
     if not any(r["mean"] is not None for r in rows):
