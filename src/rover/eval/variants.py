@@ -147,5 +147,18 @@ def parse_name_list(text: str | None, option: str) -> list[str]:
 
 
 def split_backend_specs(text: str) -> list[str]:
-    """Comma-separated backend specs; a comma inside a URL query is not expected."""
-    return parse_name_list(text, "--backend")
+    """Comma-separated backend specs; a comma inside a URL query is not expected.
+
+    An item that is a bare URL (`http://...`) is one more replica of the spec before it
+    (an endpoint pool: `openai:m@http://a/v1,http://b/v1`), not a backend of its own.
+    """
+    specs: list[str] = []
+    items = [x.strip() for x in str(text or "").split(",") if x.strip()]
+    if not items:
+        raise InputError("--backend: give at least one value")
+    for item in items:
+        if specs and item.lower().startswith(("http://", "https://")):
+            specs[-1] += "," + item
+        else:
+            specs.append(item)
+    return list(dict.fromkeys(specs))
