@@ -24,7 +24,17 @@ app = typer.Typer(
 )
 
 # command name -> module under rover.commands exposing `register(app)`
-COMMANDS = ["reason", "generate", "eval", "report", "demo", "validate", "annotate", "export"]
+COMMANDS = [
+    "reason",
+    "generate",
+    "eval",
+    "report",
+    "demo",
+    "validate",
+    "annotate",
+    "export",
+    "tasks",
+]
 
 
 def _version(value: bool) -> None:

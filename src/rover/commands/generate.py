@@ -22,6 +22,7 @@ def _split(value: str) -> list[str]:
 
 
 def generate_command(
+    ctx: typer.Context,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset directory (resumed).")],
     tasks: Annotated[str, typer.Option(help="Comma-separated task names.")] = "Lift",
     per_level: Annotated[int, typer.Option(help="Videos per level per task.")] = 3,
@@ -55,6 +56,19 @@ def generate_command(
             help="Progress: 'rover' (documented departures from Sec. 4.2) or 'paper'.",
         ),
     ] = "rover",
+    preset: Annotated[
+        str | None,
+        typer.Option(
+            help="'paper': the paper's dataset (27 kitchen tasks, Table 5's videos per level, "
+            "30/60 frames, views wrist,left,right, 256 px; --views/--size still apply).",
+        ),
+    ] = None,
+    available_only: Annotated[
+        bool,
+        typer.Option(
+            "--available-only", help="With --preset: write only the preset's tasks that exist."
+        ),
+    ] = False,
 ) -> None:
     """Generate perturbed robosuite videos with ground-truth progress, facts, events and QA."""
     from rover.exec import check_executor, make_executor
@@ -63,6 +77,11 @@ def generate_command(
     from rover.sim.tasks import get_task
 
     check_executor(executor, ray_address)  # a missing extra: one line, before any work
+    level_counts: dict[str, list[int]] = {}
+    if preset is not None:
+        tasks, level_counts, views, size = _preset(ctx, preset, available_only, views, size)
+    elif available_only:
+        raise InputError("--available-only goes with --preset")
     task_list = _split(tasks)
     if not task_list:
         raise InputError("--tasks is empty")
@@ -96,6 +115,7 @@ def generate_command(
         demos=demos,
         source_hdf5=str(source_hdf5) if source_hdf5 else None,
         progress_form=progress_form,  # type: ignore[arg-type]
+        level_counts=level_counts,
     )
     check_output_dir(out, "--out", marker="dataset.json")
     _check_resume(out, cfg)
@@ -127,6 +147,35 @@ def generate_command(
     wide = make_console(stderr=True, width=max(console.width, 140))
     if run_audit(out, wide) > 0:  # the same audit as `rover validate OUT`
         raise typer.Exit(1)
+
+
+def _preset(
+    ctx: typer.Context, preset: str, available_only: bool, views: str, size: int
+) -> tuple[str, dict[str, list[int]], str, int]:
+    """--preset paper: its tasks and per-level counts (`rover.sim.kitchen.presets`), and
+    its views and size unless given; options that would change its shape are refused."""
+    from rover.sim.kitchen.presets import PAPER_SIZE, PAPER_VIEWS, paper_plan
+    from rover.sim.tasks import task_names
+
+    if preset != "paper":
+        raise InputError(f"--preset must be 'paper', got {preset!r}")
+
+    def given(name: str) -> bool:
+        source = ctx.get_parameter_source(name)
+        return getattr(source, "name", "DEFAULT") not in ("DEFAULT", "DEFAULT_MAP")
+
+    shape = ("tasks", "per_level", "levels", "frames")
+    clash = [f"--{n.replace('_', '-')}" for n in shape if given(n)]
+    if clash:
+        raise InputError(f"--preset paper sets {', '.join(clash)} itself; leave them out")
+    names, counts, note = paper_plan(task_names("all"), available_only)
+    make_console(stderr=True).print(esc(note))
+    return (
+        ",".join(names),
+        counts,
+        views if given("views") else ",".join(PAPER_VIEWS),
+        size if given("size") else PAPER_SIZE,
+    )
 
 
 # settings that change what an episode looks like: a dataset never mixes two values

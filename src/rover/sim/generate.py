@@ -48,6 +48,9 @@ class GenerateConfig(BaseModel):
     source_hdf5: str | None = None
     # "rover": progress with the documented departures from Sec. 4.2; "paper": as written
     progress_form: Literal["rover", "paper"] = "rover"
+    # task -> videos per level (level 1 first), in place of per_level for that task: the
+    # paper preset's Table 5 counts (rover.sim.kitchen.presets)
+    level_counts: dict[str, list[int]] = {}
 
 
 @dataclass
@@ -82,7 +85,17 @@ def work_items(cfg: GenerateConfig) -> list[WorkItem]:
     for name in cfg.tasks:
         spec = get_task(name)
         per: dict[int, int] = {}
-        for index, lv in level_schedule(select_levels(spec, cfg.levels), cfg.per_level):
+        counts = cfg.level_counts.get(name)
+        chosen = select_levels(spec, cfg.levels)
+        if counts is None:
+            schedule = level_schedule(chosen, cfg.per_level)
+        else:  # one level at a time: a video's index does not depend on the other levels
+            if len(counts) != len(spec.levels):
+                raise InputError(
+                    f"{name} has {len(spec.levels)} levels, {len(counts)} counts given"
+                )
+            schedule = [p for lv in chosen for p in level_schedule([lv], counts[lv.level - 1])]
+        for index, lv in schedule:
             k = per.get(lv.level, 0)
             per[lv.level] = k + 1
             items.append(WorkItem(name, lv.level, index, k))
