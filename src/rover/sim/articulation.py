@@ -30,7 +30,10 @@ CLOSED_AT = 0.1  # "completely closed": drawer opening fraction at most this
 SIGNALS = ("drawer_opened", "drawer_closed", "door_opened", "door_closed", "pressed", "turned")
 # articulated part (= task object) names; a kitchen "door" closed by its task is one too
 # (an opened door's events come from `rover.sim.facts`, as robosuite's Door's)
-PARTS = ("drawer", "button", "knob", "door", "stop button")
+PARTS = ("drawer", "button", "knob", "door", "stop button", "sink handle", "sink spout")
+# parts turned through a fraction of a target turn: dials, and the kitchen sink's
+# faucet handle and swivelling spout (named for what they are)
+TURNED = ("knob", "sink handle", "sink spout")
 # push buttons: fact 1.0 while pressed past the switching depth; "stop button" switches
 # its appliance off (the kitchen microwave's, push-to-latch), "button" switches it on
 BUTTONS = ("button", "stop button")
@@ -103,7 +106,7 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
     drawer: grasp, open_start/open_finish (or close_start/close_finish when the task
     closes it, as for a kitchen door that starts open); button: press and turn_on (the
     appliance switches on as the button bottoms out), stop button: press and turn_off;
-    knob: grasp, turn_start, turn_finish.
+    knob (sink handle, sink spout): grasp, turn_start, turn_finish.
     """
 
     def value(f: FrameFacts) -> float:
@@ -130,7 +133,7 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
     if name in BUTTONS:
         press = _first(facts, lambda f: name in f.pressed)
         return [ev("press", press), ev("turn_off" if name == "stop button" else "turn_on", press)]
-    if name == "knob":
+    if name in TURNED:
         return [
             grasp,
             ev("turn_start", _first(facts, lambda f: value(f) > START)),

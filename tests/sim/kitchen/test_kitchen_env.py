@@ -100,11 +100,11 @@ def test_spout_reads_as_a_turned_part(sim_env):
     sim = sim_env("kitchen.TurnSinkSpout")
     sim.reset(0)
     env = sim.env
-    assert env.kind == "spout" and env.part == "knob"
+    assert env.kind == "spout" and env.part == "sink spout"  # facts name it for what it is
     sim.data.qpos[env.joint_qpos_addr] = 0.5 * env.target
     sim.sim.forward()
-    assert articulation_facts(sim)[0] == {"knob": 0.5}
-    assert not sim.predicate("turned:knob")
+    assert articulation_facts(sim)[0] == {"sink spout": 0.5}
+    assert not sim.predicate("turned:sink spout")
     sim.data.qpos[env.joint_qpos_addr] = env.target
     sim.sim.forward()
-    assert sim.predicate("turned:knob")
+    assert sim.predicate("turned:sink spout")

@@ -126,7 +126,6 @@ OPEN_SINGLE_DOOR = _spec(
 )
 
 
-# ----------------------------------------------------------- appliances on/off
 def _close_single_door() -> TaskSpec:
     """The cabinet door starts swung open `DOOR_OPEN` and is pushed shut: the drawer
     protocol with "door" (facts: the door's opening fraction; events close_start,
@@ -153,6 +152,7 @@ def _close_single_door() -> TaskSpec:
     )
 
 
+# ----------------------------------------------------------- appliances on/off
 def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
     return _spec(
         name,
@@ -198,7 +198,6 @@ def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
     )
 
 
-# ---------------------------------------------------------- fixtures and knobs
 TURN_OFF_MICROWAVE = _spec(
     "TurnOffMicrowave",
     # the microwave runs at the start; its red stop button latches down when pressed
@@ -252,6 +251,7 @@ TURN_OFF_MICROWAVE = _spec(
 )
 
 
+# ---------------------------------------------------------- fixtures and knobs
 def _early_start(milestones: list[list[str]], names: list[str]) -> list:
     """Table-5 levels whose "start turning" video stops early in the turn (20-35% of its
     expert steps, not around half): a dial turns fast, and random wrist motions from a
@@ -272,13 +272,17 @@ def _dial(
     tip: str = "tip",
     kind: str = "knob",
     turn: float = QUARTER,
+    obj: str = "knob",
 ) -> TaskSpec:
-    """A part turned about a vertical axis: stove knob, faucet handle, sink spout."""
+    """A part turned about a vertical axis: stove knob, faucet handle, sink spout.
+
+    `obj` is what the task object, its facts and events call the part ("sink handle"),
+    `kind` the fixture's joint ("knob": the faucet lever is the sink's dial)."""
     kwargs: dict = {"fixture": fixture, "part": kind, "target": turn if on else 0.0}
     if not on:
         kwargs["start_q"] = turn
-    if kind != "knob":
-        kwargs["facts_as"] = "knob"
+    if obj != kind:
+        kwargs["facts_as"] = obj
     body = "knob" if kind == "knob" else kind
     centre = "centre" if kind == "knob" else tip
     state = "on" if on else "off"
@@ -288,11 +292,11 @@ def _dial(
         env_kwargs=kwargs,
         description=f"Grasp the {part_words} and {what}.",
         group="fixtures_knobs",
-        objects=[_part("knob", fixture, body, centre, tip=tip)],
-        goals={"knob_turned": GoalSpec(kind="fixture", object="knob", body=tip)},
+        objects=[_part(obj, fixture, body, centre, tip=tip)],
+        goals={"knob_turned": GoalSpec(kind="fixture", object=obj, body=tip)},
         subtasks=[
-            _reach(f"grasp the {part_words}", "knob", "knob", "grasped:knob"),
-            _move(f"turn the {part_words}", "knob", "knob:tip", "goal:knob_turned", "turned:knob"),
+            _reach(f"grasp the {part_words}", obj, obj, f"grasped:{obj}"),
+            _move(f"turn the {part_words}", obj, f"{obj}:tip", "goal:knob_turned", f"turned:{obj}"),
         ],
         levels=_early_start(
             [[f"Approach the {part_words}"], [f"Start turning the {part_words}"]],
@@ -304,9 +308,9 @@ def _dial(
                 f"Finish turning the {part_words}",
             ],
         ),
-        milestones=["approach:knob", "contact:knob", "turn_start:knob", "turn_finish:knob"],
+        milestones=[f"approach:{obj}", f"contact:{obj}", f"turn_start:{obj}", f"turn_finish:{obj}"],
         qa_templates=_qa(
-            "knob",
+            obj,
             [
                 ("did_contact", f"Did the robot contact the {part_words}? If so, when?", "contact"),
                 (
@@ -330,15 +334,38 @@ TASKS: list[TaskSpec] = [
     _drawer(closing=False),
     _drawer(closing=True),
     OPEN_SINGLE_DOOR,
-    _button("TurnOnMicrowave", "Microwave", "microwave"),
     _close_single_door(),
-    _button("CoffeePressButton", "Coffee", "coffee machine"),
+    _button("TurnOnMicrowave", "Microwave", "microwave"),
     TURN_OFF_MICROWAVE,
+    _button("CoffeePressButton", "Coffee", "coffee machine"),
     _dial("TurnOnStove", "Stove", "stove knob", "stove", on=True),
     _dial("TurnOffStove", "Stove", "stove knob", "stove", on=False),
-    _dial("TurnOnSinkFaucet", "Sink", "sink handle", "sink", on=True, tip="handle_tip"),
-    _dial("TurnOffSinkFaucet", "Sink", "sink handle", "sink", on=False, tip="handle_tip"),
     _dial(
-        "TurnSinkSpout", "Sink", "sink spout", "sink spout", on=True, kind="spout", turn=SPOUT_TURN
+        "TurnOnSinkFaucet",
+        "Sink",
+        "sink handle",
+        "sink",
+        on=True,
+        tip="handle_tip",
+        obj="sink handle",
+    ),
+    _dial(
+        "TurnOffSinkFaucet",
+        "Sink",
+        "sink handle",
+        "sink",
+        on=False,
+        tip="handle_tip",
+        obj="sink handle",
+    ),
+    _dial(
+        "TurnSinkSpout",
+        "Sink",
+        "sink spout",
+        "sink spout",
+        on=True,
+        kind="spout",
+        turn=SPOUT_TURN,
+        obj="sink spout",
     ),
 ]
