@@ -17,7 +17,9 @@ LEGEND = (
     "milestone: episodes showing their level's milestone and not the next; events: "
     "episodes whose events agree with the facts; teleports: episodes where an untouched "
     "object rises > 2 cm between frames; final progress: mean per level (must not fall); "
-    "stalls: episodes with > 3 still expert frames in a row; tries: mean/max per episode"
+    "stalls: episodes with > 3 still expert frames in a row; joint: episodes whose "
+    "progress gains < 0.25 while an articulated part moves to its goal; tries: mean/max "
+    "per episode"
 )
 
 
@@ -32,6 +34,7 @@ def audit_table(audits) -> Table:
         ("teleports", "right"),
         ("final progress L1..Ln", "left"),
         ("stalls", "right"),
+        ("joint", "right"),
         ("tries", "right"),
         ("ok", "left"),
     ):
@@ -48,6 +51,7 @@ def audit_table(audits) -> Table:
             str(a.untouched_moved),
             means + order,
             str(a.stalls),
+            str(a.joint_lags),
             f"{sum(tries) / len(tries):.1f}/{max(tries)}" if tries else "-",
             "FAIL" if a.failed else "ok",
         )

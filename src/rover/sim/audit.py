@@ -25,6 +25,8 @@ STILL_PROGRESS = 0.01  # progress change per frame below which progress is flat 
 STILL_POS = 0.005  # ... and no hand or object moves more than this (m) ...
 STILL_GRIP = 0.02  # ... nor does the gripper open or close more than this
 ORDER_TOLERANCE = 1e-6  # mean final progress may not fall from one level to the next
+JOINT_GAIN = 0.25  # progress an articulated part must add while it moves start -> goal
+JOINT_START, JOINT_FINISH = 0.1, 0.9  # the part's fraction of the way: "moving" between
 
 
 @dataclass
@@ -37,6 +39,7 @@ class TaskAudit:
     events_ok: int = 0
     untouched_moved: int = 0  # episodes where an untouched object rises between frames
     stalls: int = 0  # episodes with an expert stall
+    joint_lags: int = 0  # episodes whose progress does not rise while a part moves
     finals: dict[int, list[float]] = field(default_factory=lambda: defaultdict(list))
     tries: dict[int, list[int]] = field(default_factory=lambda: defaultdict(list))
     problems: list[str] = field(default_factory=list)
@@ -73,6 +76,36 @@ def untouched_rises(facts: list[FrameFacts]) -> list[str]:
             rise = ob.position[2] - oa.position[2]
             if rise > RISE and not touched:
                 out.append(f"untouched {name!r} rises {rise * 100:.1f} cm at frame {t}")
+    return out
+
+
+def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
+    """Articulated parts that go from their start to their goal while progress gains less
+    than `JOINT_GAIN`: progress must follow the joint (a knob's turn, a door's swing), not
+    jump when the hand lets go. The way toward the goal is read from the first frame (a
+    part starting above half way, an open drawer to close, is measured by 1 - fraction);
+    the gain is taken from the last frame at most `JOINT_START` of the way to the first
+    frame at least `JOINT_FINISH` of it."""
+    out = []
+    if not facts or len(progress) != len(facts):
+        return out
+    for name, first in facts[0].articulations.items():
+        way = [
+            (1.0 - v if first > 0.5 else v)
+            for v in (f.articulations.get(name, first) for f in facts)
+        ]
+        done = next((t for t, w in enumerate(way) if w >= JOINT_FINISH), None)
+        if done is None:
+            continue
+        start = next((t for t in range(done - 1, -1, -1) if way[t] <= JOINT_START), None)
+        if start is None:
+            continue
+        gain = progress[done] - progress[start]
+        if gain < JOINT_GAIN:
+            out.append(
+                f"progress gains {gain:.2f} < {JOINT_GAIN} while the {name} moves to its goal "
+                f"(frames {start}-{done})"
+            )
     return out
 
 
@@ -158,6 +191,10 @@ def audit(episodes: Iterable[Episode]) -> list[TaskAudit]:
         if rises:
             ta.untouched_moved += 1
             ta.problems += [f"{ep.id}: {p}" for p in rises]
+        lags = joint_lags(facts, list(truth.progress))
+        if lags:
+            ta.joint_lags += 1
+            ta.problems += [f"{ep.id}: {p}" for p in lags]
         stalls = expert_stalls(ep)
         if stalls:
             ta.stalls += 1

@@ -1,0 +1,31 @@
+"""The audit's articulated-progress check: progress must rise while a part moves."""
+
+from __future__ import annotations
+
+from rover.episode import FrameFacts
+from rover.sim.audit import joint_lags
+
+
+def _facts(values, part="knob"):
+    return [FrameFacts(articulations={part: v}) for v in values]
+
+
+def test_progress_rising_with_the_knob_passes_and_a_jump_at_release_fails():
+    turn = [0.0, 0.0, 0.1, 0.4, 0.7, 0.95, 0.95, 0.95]
+    follows = [0.0, 0.3, 0.5, 0.65, 0.8, 0.97, 1.0, 1.0]
+    assert joint_lags(_facts(turn), follows) == []
+    # flat while the knob turns, 1.0 only once the hand lets go (the old TurnKnob curve)
+    jumps = [0.0, 0.3, 0.5, 0.5, 0.5, 0.51, 1.0, 1.0]
+    (why,) = joint_lags(_facts(turn), jumps)
+    assert "knob" in why and "frames 2-5" in why
+
+
+def test_a_closing_drawer_is_measured_toward_closed_and_unfinished_moves_are_skipped():
+    closing = [1.0, 1.0, 0.8, 0.5, 0.2, 0.05]
+    assert joint_lags(_facts(closing, "drawer"), [0, 0.5, 0.6, 0.7, 0.85, 1.0]) == []
+    assert joint_lags(_facts(closing, "drawer"), [0, 0.5, 0.5, 0.5, 0.5, 0.55])
+    # never reaches the goal (a "start opening" level): nothing to check
+    assert joint_lags(_facts([0.0, 0.2, 0.5, 0.6]), [0.0, 0.1, 0.1, 0.1]) == []
+    # no articulated part, or progress of another length: nothing to check
+    assert joint_lags([FrameFacts()] * 3, [0.0, 0.0, 0.0]) == []
+    assert joint_lags(_facts([0.0, 1.0]), [0.0]) == []
