@@ -34,6 +34,7 @@ COMMANDS = [
     "annotate",
     "export",
     "tasks",
+    "watch",
 ]
 
 
