@@ -14,6 +14,7 @@ import json
 from typing import Annotated, Any
 
 import typer
+from rich import box
 from rich.table import Table
 
 from rover.console import esc, make_console
@@ -54,19 +55,25 @@ def task_rows(suite: str = "all", names: list[str] | None = None) -> list[dict[s
 
 
 def _table(rows: list[dict[str, Any]]) -> Table:
-    table = Table(title="rover tasks", title_justify="left")
-    for col in ("task", "suite", "group", "subtasks", "levels", "frames", "expert success"):
-        table.add_column(col, no_wrap=col in ("task", "frames"))
+    """A task's name with its subtasks under it, so a narrow terminal still reads well."""
+    suites = len({r["suite"] for r in rows}) > 1
+    table = Table(title="rover tasks", title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
+    table.add_column("task: subtasks", ratio=1, min_width=30)
+    if suites:
+        table.add_column("suite", no_wrap=True)
+    table.add_column("group", max_width=18)
+    table.add_column("levels", justify="right", no_wrap=True)
+    table.add_column("frames", justify="right", no_wrap=True)
+    table.add_column("expert", no_wrap=True)
     for r in rows:
         e = r["expert_success"]
         cell = "not measured"
         if e["measured"]:
-            cell = f"{e['successes']}/{e['seeds']} ({e['date']})" + (" stale" if e["stale"] else "")
+            cell = f"{e['successes']}/{e['seeds']}" + (" stale" if e["stale"] else "")
         table.add_row(
-            esc(r["name"]),
-            esc(r["suite"]),
+            f"[bold]{esc(r['name'])}[/bold]\n  [dim]{esc(' → '.join(r['subtasks']))}[/dim]",
+            *([esc(r["suite"])] if suites else []),
             esc(r["group_title"]),
-            esc(" → ".join(r["subtasks"])),
             str(len(r["levels"])),
             str(r["frames"]),
             esc(cell),
@@ -142,10 +149,14 @@ def tasks_command(
     console.print(_table(rows))
     if suite in ("all", "kitchen"):
         console.print(esc(_paper_note(rows)))
+    dates = sorted({r["expert_success"]["date"] for r in rows if r["expert_success"]["measured"]})
+    when = (
+        f", measured {dates[0]}" + (f" to {dates[-1]}" if len(dates) > 1 else "") if dates else ""
+    )
     console.print(
-        "expert success: measured by `python benchmarks/expert_success.py --write` "
-        "(src/rover/sim/expert_success.json); `rover tasks NAME` shows one task's levels, "
-        "milestones and questions, --json everything"
+        "expert: scripted-expert successes / seeds, from `python benchmarks/expert_success.py "
+        f"--write` (src/rover/sim/expert_success.json{when}); `rover tasks NAME` shows a "
+        "task's levels, milestones, questions and its measurement, --json everything"
     )
 
 
