@@ -350,6 +350,8 @@ class SimEnv:
             return self.grasped(obj)
         if kind == "lifted":
             return self.lifted(obj) and self.grasped(obj)
+        if kind == "placed" and "region" in self.spec.goals:  # a kitchen goal region
+            return self.env.item_in_goal() and not self.grasped(obj)
         if kind == "placed":
             return self.in_bin(obj) == self.spec.bins[obj] and not self.grasped(obj)
         if kind == "stacked":
@@ -384,6 +386,8 @@ class SimEnv:
         kind, _, obj = signal.partition(":")
         if kind in ("grasped", "lifted"):
             return obj in self.finger_contacts()
+        if kind == "placed" and "region" in self.spec.goals:
+            return self.env.item_in_goal()
         if kind == "placed":
             return self.in_bin(obj) == self.spec.bins[obj]
         if kind == "stacked":

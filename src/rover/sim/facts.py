@@ -124,6 +124,9 @@ def frame_facts(
 def _inside(sim: SimEnv, obj: str) -> str | None:
     if not sim.spec.object_spec(obj).graspable:
         return None
+    place = _kitchen_place(sim)
+    if place is not None:  # a kitchen item: the region it rests in (sink basin, ...)
+        return place[1] if place[0] == "inside" else None
     if hasattr(sim.env, "not_in_bin"):  # robosuite PickPlace: the four target compartments
         idx = sim.in_bin(obj)
         if idx is not None:
@@ -137,10 +140,19 @@ def _inside(sim: SimEnv, obj: str) -> str | None:
     return None
 
 
+def _kitchen_place(sim: SimEnv) -> tuple[str, str] | None:
+    """A kitchen pick-and-place item's (relation, region); None elsewhere or when loose."""
+    where = getattr(sim.env, "item_place", None)
+    return where() if where is not None else None
+
+
 def _on(sim: SimEnv, obj: str, lifted: bool, held: bool) -> str | None:
     spec = sim.spec
     if not spec.object_spec(obj).graspable or held or _inside(sim, obj):
         return None
+    if getattr(sim.env, "item_category", None):  # a kitchen item: the surface region only
+        place = _kitchen_place(sim)
+        return place[1] if place is not None and place[0] == "on" else None
     for other in spec.objects:
         if other.name != obj and other.graspable and sim.on_top(obj, other.name):
             return other.name
@@ -195,6 +207,8 @@ def target_reached(spec: TaskSpec, obj: str, f: FrameFacts) -> bool:
         return o.inside == "peg"
     if "on" in spec.goals:
         return o.on == spec.goals["on"].object
+    if "region" in spec.goals:  # a kitchen goal region, named in the env's arguments
+        return spec.env_kwargs.get("goal") in (o.inside, o.on)
     return False
 
 
@@ -248,7 +262,7 @@ def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
             drop = next((t for kind, t in ends if kind == "drop"), None)
             place = next((t for kind, t in ends if kind == "place"), None)
             events.append(Event(name="drop", object=name, frame=drop))
-            if spec.bins or "on" in spec.goals or "peg" in spec.goals:
+            if spec.bins or "on" in spec.goals or "peg" in spec.goals or "region" in spec.goals:
                 events.append(Event(name="place", object=name, frame=place))
         elif name == "door" and not articulation.closing(spec, name):
             events.append(

@@ -55,12 +55,22 @@ def achieved(component: str, facts: Sequence[FrameFacts], events: Sequence[Event
             for f in facts
         )
     if kind == "place":  # placed, or let fall and come to rest in its goal all the same
-        return any(_in_goal(f, obj) for f in facts) or _event(kind, obj, events)
+        # (a region other than the one it starts in: a kitchen item leaving the sink
+        # for the counter starts "inside" the sink, which is not its goal)
+        start = _where(facts[0], obj) if facts else None
+        return any(_in_goal(f, obj) and _where(f, obj) != start for f in facts) or _event(
+            kind, obj, events
+        )
     return _event(kind, obj, events)
 
 
 def _event(kind: str, obj: str, events: Sequence[Event]) -> bool:
     return any(e.name == kind and e.object == obj and e.frame is not None for e in events)
+
+
+def _where(f: FrameFacts, obj: str) -> tuple[str | None, str | None] | None:
+    o = f.objects.get(obj)
+    return None if o is None else (o.inside, o.on)
 
 
 def _in_goal(f: FrameFacts, obj: str) -> bool:

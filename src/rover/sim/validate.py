@@ -34,6 +34,11 @@ def _placed(f: FrameFacts, obj: str) -> bool:
     return o is None or o.inside not in (None, "start bin") or o.on not in (None, "table")
 
 
+def _where(f: FrameFacts, obj: str) -> tuple[str | None, str | None] | None:
+    o = f.objects.get(obj)
+    return None if o is None else (o.inside, o.on)
+
+
 def _held(f: FrameFacts, obj: str) -> bool:
     return f.holding == obj
 
@@ -75,7 +80,13 @@ def event_problems(event: Event, facts: list[FrameFacts]) -> list[str]:
     if rule is None:
         return []
     check, why = rule
-    if not check(facts[event.frame], event.object):
+    at = facts[event.frame]
+    home = _where(at, event.object) == _where(facts[0], event.object)
+    if event.name in ("drop", "place") and home:
+        # back where it started (a kitchen item on the counter it was taken from, one in
+        # the sink it started in): never its goal, whatever that place is called
+        check = (lambda f, o: f.holding != o) if event.name == "drop" else (lambda f, o: False)
+    if not check(at, event.object):
         return [f"event {event.name} {event.object!r} at frame {event.frame}, but {why} there"]
     begins = HOLD_CHANGE.get(event.name)
     if begins is False and event.frame == 0:

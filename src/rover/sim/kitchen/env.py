@@ -28,13 +28,16 @@ from rover.sim.fixtures.base import FixtureEnv, FixtureObject
 from rover.sim.fixtures.button import PRESS_Q
 from rover.sim.fixtures.drawer import OPEN_Q
 from rover.sim.kitchen.fixtures import COUNTER_SIZE, COUNTER_TOP, FIXTURES
+from rover.sim.kitchen.items import ItemGeoms, build_item, mass_inertia
 from rover.sim.kitchen.objects import CATALOGUE, build_object, draw_decor, half_height, make_static
+from rover.sim.kitchen.placement import draw_item, item_bottom, item_place
 from rover.sim.kitchen.scene import TEXTURES, Scene, draw_scene, draw_style
 
 TEXTURE_DIR = Path(robosuite.__file__).resolve().parent / "models" / "assets" / "textures"
 HIDDEN_X = 6.0  # m: unused fixtures stand on the floor outside the room's walls
 HIDDEN_Z = -3.0  # m: unused décor (welded, so it touches nothing) waits below the floor
 LIGHT = "kitchen_light"
+COUNTER_GOAL = "kitchen_counter_goal"  # site: the counter spot a pick-and-place item goes to
 # the kitchen's two workspace cameras (render views "left" / "right"): free-view style
 # (look-at point, distance, azimuth, elevation in degrees) made into model cameras so
 # robosuite's CameraModder can jitter them per scene
@@ -71,6 +74,9 @@ class RoverKitchen(FixtureEnv):
             sink spout is read as a "knob" (turned through a fraction of its target).
         start_q, target, reach: as in `FixtureEnv` (a door to close starts open, ...).
         also_used: further fixtures placed within reach (composite tasks).
+        item: category of a free item to pick and place ("vegetable"; None: no item).
+            The fixture part is then only the fixture's pose (no articulation facts).
+        start, goal: the item's start and goal regions (`rover.sim.kitchen.regions`).
         **kwargs: the usual `ManipulationEnv` arguments.
     """
 
@@ -81,13 +87,18 @@ class RoverKitchen(FixtureEnv):
         part: str = "drawer",
         facts_as: str | None = None,
         also_used: tuple[str, ...] = (),
+        item: str | None = None,
+        start: str = "counter",
+        goal: str = "counter",
         **kwargs,
     ) -> None:
         if fixture not in FIXTURES or part not in FIXTURES[fixture].joints:
             raise ValueError(f"kitchen fixture {fixture!r} has no part {part!r}")
         self.fixture_name = fixture
         self.kind = part  # the fixture's own part name (the experts read this)
-        self.part = facts_as or part
+        self.part = "" if item else (facts_as or part)
+        self.item_category, self.item_start, self.item_goal = item, start, goal
+        self.item_geoms: ItemGeoms | None = None
         self.joint = FIXTURES[fixture].joints[part]
         self.used = [fixture, *[f for f in also_used if f != fixture]]
         self.scene: Scene | None = None
@@ -123,10 +134,12 @@ class RoverKitchen(FixtureEnv):
             obj = build_object(inst)
             make_static(obj)
             self.decor[inst.name] = obj
+        self.item = build_item(self.item_category) if self.item_category else None
         self.model = ManipulationTask(
             mujoco_arena=arena,
             mujoco_robots=[robot.robot_model for robot in self.robots],
-            mujoco_objects=[*self.fixtures.values(), *self.decor.values()],
+            mujoco_objects=[*self.fixtures.values(), *self.decor.values()]
+            + ([self.item] if self.item is not None else []),
         )
         # a fixture's case is welded to the world, so MuJoCo's parent-child filter does not
         # keep its moving parts (a button sinking into the roof, a knob on its deck) from
@@ -150,6 +163,15 @@ class RoverKitchen(FixtureEnv):
             contype="0",
             conaffinity="0",
             material="walls_mat",
+        )
+        ET.SubElement(
+            arena.worldbody,
+            "site",
+            name=COUNTER_GOAL,
+            pos=f"0 0 {COUNTER_TOP}",
+            size="0.005",
+            rgba="0 0 0 0",
+            group="4",
         )
         light = arena.worldbody.find("light")
         light.set("name", LIGHT)
@@ -179,6 +201,12 @@ class RoverKitchen(FixtureEnv):
         self.joint_id = m.joint_name2id(self.joint_name)
         self.joint_qpos_addr = m.get_joint_qpos_addr(self.joint_name)
         self.decor_body_ids = {n: m.body_name2id(o.root_body) for n, o in self.decor.items()}
+        self.counter_goal_site = m.site_name2id(COUNTER_GOAL)
+        if self.item is not None:
+            self.item_body_id = m.body_name2id(self.item.root_body)
+            self.item_qpos_addr = m.get_joint_qpos_addr(self.item.joints[0])
+            if self.item_geoms is None:  # once: later calls see a scene's switched geoms
+                self.item_geoms = ItemGeoms.of(m._model, self.item_category)
         names = [m.geom_id2name(g) or "" for g in range(m.ngeom)]
         self.decor_geoms = {
             n: [g for g in range(m.ngeom) if names[g].startswith(o.naming_prefix)]
@@ -209,9 +237,18 @@ class RoverKitchen(FixtureEnv):
     def _reset_internal(self) -> None:
         ManipulationEnv._reset_internal(self)
         self.scene = draw_scene(self.rng, self.used, draw_decor(self.rng))
+        if self.item is not None:
+            self.scene.item = draw_item(self.rng, self)
         self.apply_scene(self.scene)
         self.sim.data.qpos[self.joint_qpos_addr] = self.start_q
         self.sim.data.qvel[self.model_dof_addr()] = 0.0
+        if self.item is not None:  # the item at rest in its start region
+            a, b = self.item_qpos_addr
+            self.sim.data.qpos[a:b] = self.scene.item["qpos"]
+            dof = int(
+                self.sim.model._model.jnt_dofadr[self.sim.model.joint_name2id(self.item.joints[0])]
+            )
+            self.sim.data.qvel[dof : dof + 6] = 0.0
         self.sim.forward()
 
     def restyle(self, seed: int) -> None:
@@ -247,6 +284,8 @@ class RoverKitchen(FixtureEnv):
             m.body_quat[bid] = _yaw_quat(d["yaw"])
             for g in self.decor_geoms[inst.name]:
                 m.geom_rgba[g][:3] = d["rgb"]
+        if self.item is not None and scene.item is not None:
+            self._apply_item(scene.item)
         for surface, geoms in self.surface_geoms.items():
             mat = self.material_ids[(surface, scene.textures[surface])]
             for g in geoms:
@@ -278,3 +317,47 @@ class RoverKitchen(FixtureEnv):
             modder.random_state = np.random.RandomState(seed)
             modder.randomize()
         self.sim.forward()
+
+    # ---------------------------------------------------------- pick and place
+    def _apply_item(self, item: dict) -> None:
+        """Show the drawn instance (geoms, colour, mass) and put the counter goal spot."""
+        m = self.sim.model._model
+        self.item_geoms.show(m, item["name"], item["rgb"])
+        mass, inertia = mass_inertia(self.item_instance())
+        m.body_mass[self.item_body_id] = mass
+        m.body_inertia[self.item_body_id] = inertia
+        m.body_ipos[self.item_body_id] = 0.0
+        m.body_iquat[self.item_body_id] = [1.0, 0.0, 0.0, 0.0]
+        m.site_pos[self.counter_goal_site] = [*item["counter"], COUNTER_TOP]
+
+    def item_instance(self):
+        """The catalogue `Instance` this scene's item is."""
+        name = self.scene.item["name"]
+        return next(i for i in CATALOGUE if i.name == name)
+
+    def fixture_poses(self) -> dict[str, tuple[np.ndarray, float]]:
+        """Fixture name -> (origin, yaw) of every fixture standing on the counter."""
+        out = {}
+        for name, place in self.scene.layout.items():
+            if place is not None:
+                out[name] = (np.array([place.x, place.y, COUNTER_TOP]), place.yaw)
+        return out
+
+    def item_place(self) -> tuple[str, str] | None:
+        """(relation, region) the item rests in now ("inside", "sink"), or None."""
+        if self.item is None or self.scene is None:
+            return None
+        return item_place(self)
+
+    def item_in_goal(self) -> bool:
+        """The item rests in its goal region (touched or not)."""
+        found = self.item_place()
+        return found is not None and found[1] == self.item_goal
+
+    def _check_success(self) -> bool:
+        if self.item is not None:  # pick and place: the item rests in its goal region
+            return self.item_in_goal()
+        return super()._check_success()
+
+    def item_bottom(self) -> float:
+        return item_bottom(self)

@@ -59,6 +59,8 @@ class Scene:
     light_seed: int  # seeds robosuite's LightingModder
     camera_seed: int  # seeds robosuite's CameraModder (small pose jitter)
     decor: list[dict] = field(default_factory=list)  # object instances on the counter
+    # pick and place: the item's instance, colour, start pose and counter spot (`placement`)
+    item: dict | None = None
 
     def to_json(self) -> dict:
         out = asdict(self)

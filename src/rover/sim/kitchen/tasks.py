@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from rover.sim.kitchen.language import PARAPHRASES
+from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
 from rover.sim.tasks._common import FINGERS, named_levels
 from rover.sim.tasks.articulated import drawer_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
@@ -369,3 +370,4 @@ TASKS: list[TaskSpec] = [
         obj="sink spout",
     ),
 ]
+TASKS += PICK_PLACE_TASKS  # the pick-and-place group (rover.sim.kitchen.pick_place)

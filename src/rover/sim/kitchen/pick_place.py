@@ -1,0 +1,99 @@
+"""The kitchen suite's pick-and-place tasks (paper App. B, Table 4; Table 5; App. C.3; App. N).
+
+Each task moves one free item of a category (`rover.sim.kitchen.items`; the instance is
+drawn per seed and recorded in ``episode.json`` under ``extra.scene.item``) from a start
+region to a goal region (`rover.sim.kitchen.regions`): the counter beside the fixture
+in use, the sink basin, the stove's cooktop. As for robosuite's PickPlace tasks
+(`rover.sim.tasks.pick_place`), the object-centric subtasks are "pick up the item" (the
+fingers come to it; ends when it is lifted in the grasp) and "place it" (the item is
+carried to the goal region's point; ends when it rests there, let go), the levels are
+Table 5's seven pick-and-place levels, the questions App. C.3's, and the expert the
+tabletop pick-and-place script. The facts report the region as ``inside``/``on``, so a
+hold that ends with the item resting in the goal region is a ``place`` and any other a
+``drop`` (`rover.sim.facts`).
+
+The item is named by its category ("the vegetable") in the instruction, the subtasks and
+the questions, which stay fixed per task while the instance changes with the seed.
+"""
+
+from __future__ import annotations
+
+from rover.sim.kitchen.items import host_body
+from rover.sim.tasks._common import (
+    grasp_subtask,
+    move_subtask,
+    pick_place_levels,
+    pick_place_milestones,
+    pick_place_qa,
+)
+from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
+
+SUITE = "kitchen"
+# where a region's goal point is taken from: a fixture site, or the counter spot site
+# the env moves per scene (plus a world offset: the sink's point sits in the basin's
+# front half, clear of the spout hanging over its back)
+GOAL_POINT = {
+    "sink": ("Sink_basin", (-0.05, 0.0, 0.0)),
+    "stove": ("Stove_burner", (0.0, 0.0, 0.0)),
+    "counter": ("kitchen_counter_goal", (0.0, 0.0, 0.0)),
+}
+# how the instruction names a region as a start ("from ...") and as a goal
+FROM = {"sink": "the sink", "stove": "the stove", "counter": "the counter"}
+TO = {"sink": "in the sink", "stove": "on the stove", "counter": "on the counter"}
+FIXTURE_OF = {"sink": "Sink", "stove": "Stove"}
+
+
+def _paraphrases(obj: str, start: str, goal: str) -> list[str]:
+    return [
+        f"Take the {obj} from {FROM[start]} and put it {TO[goal]}.",
+        f"Move the {obj} from {FROM[start]} to {FROM[goal]}.",
+        f"Pick up the {obj} that is {TO[start]} and set it down {TO[goal]}.",
+    ]
+
+
+def pick_place(name: str, category: str, start: str, goal: str) -> TaskSpec:
+    """One kitchen pick-and-place task: an item of `category` from `start` to `goal`."""
+    fixture = FIXTURE_OF[goal if start == "counter" else start]
+    obj = category
+    target = TO[goal]
+    site, offset = GOAL_POINT[goal]
+    return TaskSpec(
+        name=f"{SUITE}.{name}",
+        env_name="RoverKitchen",
+        env_kwargs={
+            "fixture": fixture,
+            "part": next(iter(_parts(fixture))),
+            "item": category,
+            "start": start,
+            "goal": goal,
+        },
+        description=f"Pick the {obj} from {FROM[start]} and place it {target}.",
+        paraphrases=_paraphrases(obj, start, goal),
+        suite=SUITE,
+        group="pick_and_place",
+        objects=[ObjectSpec(name=obj, body=host_body(category))],
+        goals={"region": GoalSpec(kind="body", body=site, offset=offset)},
+        subtasks=[
+            grasp_subtask(f"pick up the {obj}", obj),
+            move_subtask(f"place the {obj} {target}", obj, "goal:region", f"placed:{obj}"),
+        ],
+        levels=pick_place_levels(obj, target),
+        milestones=pick_place_milestones(obj),
+        qa_templates=pick_place_qa(obj, target),
+        expert="pick_place",
+        max_expert_steps=500,
+    )
+
+
+def _parts(fixture: str) -> dict[str, str]:
+    from rover.sim.kitchen.fixtures import FIXTURES
+
+    return FIXTURES[fixture].joints
+
+
+TASKS: list[TaskSpec] = [
+    pick_place("PickPlaceCounterToSink", "vegetable", "counter", "sink"),
+    pick_place("PickPlaceSinkToCounter", "vegetable", "sink", "counter"),
+    pick_place("PickPlaceCounterToStove", "vegetable", "counter", "stove"),
+    pick_place("PickPlaceStoveToCounter", "vegetable", "stove", "counter"),
+]
