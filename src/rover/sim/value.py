@@ -27,6 +27,10 @@ import numpy as np
 from rover.sim.adapter import SimAdapter
 
 KEYPOINT_PROMINENCE = 0.1  # fraction of the subtask's y range a local maximum must stand out
+# a joint's whole way to its goal weighs at least as much as this much hand travel (m):
+# a knob tip's quarter turn moves 3 cm and a button's 1 cm, so the hand's distance
+# would otherwise swamp the joint in any state off the expert's path
+JOINT_SPAN_MIN = 0.10
 
 
 class SubtaskLike(Protocol):
@@ -49,6 +53,8 @@ class Tracks:
     entities: np.ndarray  # (N, B, 3): end effector first, then every task object
     # end signal -> (N,) whether that subtask's achievement still stands at each step
     kept: dict[str, np.ndarray] = field(default_factory=dict)
+    # end signal -> (N,) whether the state meets the signal itself (the subtask's end test)
+    reached: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.entities.shape[0])
@@ -59,6 +65,7 @@ class Tracks:
             {k: v[idx] for k, v in self.points.items()},
             self.entities[idx],
             {k: v[idx] for k, v in self.kept.items()},
+            {k: v[idx] for k, v in self.reached.items()},
         )
 
 
@@ -80,15 +87,18 @@ def point_tracks(
 ) -> Tracks:
     """Measure named points and entity positions in each state (restores the current state).
 
-    ``signals``: subtask end signals whose standing (``adapter.kept``) is recorded per
-    step, for the undo rule of `progress_from_tracks`; adapters without ``kept`` skip it.
+    ``signals``: subtask end signals whose standing (``adapter.kept``) and whose end test
+    (``adapter.predicate``) are recorded per step, for the undo and reach rules of
+    `progress_from_tracks`; adapters without ``kept`` skip both.
     """
     saved = adapter.get_state()
     pts: dict[str, list[np.ndarray]] = {n: [] for n in names}
     ents: list[np.ndarray] = []
     kept_fn = getattr(adapter, "kept", None)
+    test_fn = getattr(adapter, "predicate", None)
     signals = list(signals) if kept_fn is not None else []
     kept: dict[str, list[bool]] = {s: [] for s in signals}
+    reached: dict[str, list[bool]] = {s: [] for s in signals if test_fn is not None}
     try:
         for s in np.asarray(states):
             adapter.set_state(s)
@@ -97,12 +107,15 @@ def point_tracks(
             ents.append(np.asarray(adapter.entity_positions(), dtype=np.float64))
             for sig in signals:
                 kept[sig].append(bool(kept_fn(sig)))
+            for sig in reached:
+                reached[sig].append(bool(test_fn(sig)))
     finally:
         adapter.set_state(saved)
     return Tracks(
         {n: np.stack(v) for n, v in pts.items()},
         np.stack(ents),
         {k: np.asarray(v, dtype=bool) for k, v in kept.items()},
+        {k: np.asarray(v, dtype=bool) for k, v in reached.items()},
     )
 
 
@@ -269,11 +282,47 @@ def subtask_goal_distance(
 
 
 def _joint_span(expert: Tracks, sub: SubtaskLike, a: int) -> float | None:
-    """The grip point's distance to its goal at the expert subtask's first step (m)."""
+    """The grip point's distance to its goal at the expert subtask's first step (m), at
+    least `JOINT_SPAN_MIN`."""
     if not getattr(sub, "joint", None) or sub.goal is None:
         return None
     p = expert.points[sub.object_points[0]][a]
-    return max(float(np.linalg.norm(p - expert.points[sub.goal][a])), 1e-3)
+    return max(float(np.linalg.norm(p - expert.points[sub.goal][a])), JOINT_SPAN_MIN)
+
+
+def _reach(
+    tracks: Tracks, q: np.ndarray, sub_idx: np.ndarray, subtasks, bounds
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Steps whose state already meets the end test of their subtask or a later one are
+    valued past it: (q, subtask, done).
+
+    A rollout step's q is where it branched off the expert, so on a random ending that
+    happens to finish a subtask (a knob turned all the way, a drawer pulled open) q lags
+    the state and the step would be valued in the earlier subtask, capped at its share
+    (the "ends at exactly 0.50" videos). Such a step moves to the subtask after the last
+    one whose test it meets, from that subtask's first expert step; meeting the last
+    subtask's test is the task done (``done``: valued as the expert's end). The expert
+    itself is unchanged: it meets each test first at the end of that subtask.
+    """
+    q, sub_idx = q.copy(), sub_idx.copy()
+    done = np.zeros(len(q), dtype=bool)
+    if not tracks.reached:
+        return q, sub_idx, done
+    n_sub = len(subtasks)
+    hit = np.stack(
+        [tracks.reached.get(s.end_signal, np.zeros(len(q), bool)) for s in subtasks], axis=1
+    )
+    for r in range(len(q)):
+        met = np.flatnonzero(hit[r, int(sub_idx[r]) :])
+        if not len(met):
+            continue
+        i = int(sub_idx[r]) + int(met[-1])
+        if i == n_sub - 1:
+            done[r] = True
+            sub_idx[r], q[r] = i, max(int(q[r]), bounds[i][0])
+        else:
+            sub_idx[r], q[r] = i + 1, max(int(q[r]), bounds[i + 1][0])
+    return q, sub_idx, done
 
 
 def _undo(
@@ -332,10 +381,11 @@ def progress_from_tracks(
         goal_end: expert step at which the last subtask's goal is achieved; the expert
             steps after it (the hand retreating) are valued as done while the goal still
             stands. None: the last subtask runs to the expert's last step (the paper).
-        form: "rover" (default) adds three departures from Sec. 4.2, each documented in
+        form: "rover" (default) adds four departures from Sec. 4.2, each documented in
             docs/ground_truth.md: articulated goals measured by joint state, subtasks ending
-            at their goal (`goal_end`), and undone subtasks revalued (`Tracks.kept`);
-            "paper" uses the paper's formulas only.
+            at their goal (`goal_end`), undone subtasks revalued (`Tracks.kept`), and
+            steps whose state meets a later subtask's end test valued past it
+            (`Tracks.reached`); "paper" uses the paper's formulas only.
     """
     q = np.asarray(q, dtype=np.int64)
     if len(subtasks) != len(bounds):
@@ -350,10 +400,12 @@ def progress_from_tracks(
     ends = np.asarray([b for _, b in bounds])
     sub_idx = np.minimum(np.searchsorted(ends, q, side="left"), len(ends) - 1)
     if rover:
+        q, sub_idx, done = _reach(tracks, q, sub_idx, subtasks, bounds)
         q, sub_idx = _undo(tracks, q, sub_idx, subtasks, bounds)
         last_kept = tracks.kept.get(getattr(subtasks[-1], "end_signal", ""))
         if last_kept is not None:
             after_goal &= last_kept
+        after_goal |= done & (sub_idx == len(bounds) - 1)
         after_goal &= sub_idx == len(bounds) - 1
     v = np.zeros(len(q))
     completion = np.zeros(len(bounds))
