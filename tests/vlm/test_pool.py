@@ -205,3 +205,14 @@ def test_config_file_base_urls_make_a_pool(tmp_path: Path, monkeypatch):
     cfg.write_text('backend = "openai:qwen@http://a/v1"\nbase_urls = ["http://b/v1"]\n')
     with pytest.raises(InputError, match="once"):
         default_backend()
+
+
+def test_a_pool_nobody_answers_fails_with_one_line_naming_it(fast_config, make_prompt):
+    config = fast_config.model_copy(update={"no_cache": True, "max_retries": 1})
+    dead = [_closed_port_url(), _closed_port_url().replace("http://", "http://u:dead-pw@")]
+    vlm = load_vlm(f"openai:m@{dead[0]},{dead[1]}", config)
+    with pytest.raises(BackendError) as err:
+        _ask_many(vlm, [make_prompt("x")])
+    message = str(err.value)
+    assert "cannot connect to the pool (http://127.0.0.1:" in message
+    assert "dead-pw" not in message and "\n" not in message

@@ -114,7 +114,7 @@ class OpenAIBackend(BaseBackend):
     def where(self) -> str:
         """The server, as shown in messages (credentials removed)."""
         if self.pool is not None:
-            return f"every replica of the pool ({self.pool.describe()})"
+            return f"the pool ({self.pool.describe()})"
         return endpoint_identity(self.base_url) if self.base_url else "api.openai.com"
 
     def cache_extra(self) -> dict[str, Any]:
