@@ -153,3 +153,84 @@ def test_knob_joint_fraction_and_facts_follow_the_joint(sim_env):
         seen.append((sim.joint_fraction("knob"), frame_facts(sim).articulations["knob"]))
     assert [round(a, 2) for a, _ in seen] == [0.0, 0.25, 0.5, 1.0]
     assert [b for _, b in seen] == sorted(b for _, b in seen) and seen[-1][1] == 1.0
+
+
+def test_letting_go_off_the_goal_is_a_drop_and_in_it_a_place(can):
+    """The same release, once with the can resting in its bin and once with it set back on
+    the table: place in the first, drop in the second (the goal region decides)."""
+    from rover.sim.facts import detect_events, facts_for_states
+
+    sim, demo = can
+    prev = np.concatenate([demo.states[:1], demo.states[:-1]])
+    facts = facts_for_states(sim, demo.states, prev)
+    ev = {e.name: e.frame for e in detect_events(sim.spec, facts)}
+    held, let_go = demo.states[ev["place"] - 1], demo.states[ev["place"]]
+    on_table = let_go.copy()
+    qa = _free_qpos(sim, "Can_main")
+    on_table[qa : qa + 3] = demo.states[0][qa : qa + 3]  # back where it started
+    for end, kind in ((let_go, "place"), (on_table, "drop")):
+        states = np.stack([demo.states[0], held, end])
+        f = facts_for_states(sim, states, np.stack([states[0], prev[ev["place"] - 1], held]))
+        assert f[1].holding == "can" and f[2].holding is None
+        got = {e.name: e.frame for e in detect_events(sim.spec, f)}
+        other = "drop" if kind == "place" else "place"
+        assert got[kind] == 2 and got[other] is None, (kind, got)
+
+
+def _set_joint(sim, fraction_of_way: float) -> None:
+    fx = sim.env
+    s = sim.get_state()
+    s[1 + fx.joint_qpos_addr] = fx.start_q + fraction_of_way * (fx.target - fx.start_q)
+    sim.set_state(s)
+
+
+def test_closing_drawer_fact_is_its_opening_and_events_follow_it(sim_env):
+    """CloseDrawer: the joint fraction counts toward closed, the fact says how far open;
+    close_start fires once it is under 90% open, close_finish at 10% open or less."""
+    from rover.sim.facts import detect_events, frame_facts
+
+    sim = sim_env("CloseDrawer")
+    sim.reset(0)
+    facts = []
+    for way in (0.0, 0.05, 0.3, 0.6, 0.95):
+        _set_joint(sim, way)
+        assert sim.joint_fraction("drawer") == pytest.approx(way, abs=1e-6)
+        facts.append(frame_facts(sim))
+    opening = [f.articulations["drawer"] for f in facts]
+    assert opening[0] == 1.0 and opening == sorted(opening, reverse=True)
+    ev = {e.name: e.frame for e in detect_events(sim.spec, facts) if e.object == "drawer"}
+    assert ev["close_start"] == 2 and ev["close_finish"] == 4
+    assert ev["grasp"] is None  # nothing held the handle
+
+
+def test_button_is_pressed_only_past_its_switching_depth(sim_env):
+    from rover.sim.facts import detect_events, frame_facts
+
+    sim = sim_env("PressButton")
+    sim.reset(0)
+    facts = []
+    for way in (0.0, 0.5, 0.85, 0.95):  # switching depth = 90% of the way
+        _set_joint(sim, way)
+        facts.append(frame_facts(sim))
+    assert [("button" in f.pressed) for f in facts] == [False, False, False, True]
+    assert [f.articulations["button"] for f in facts] == [0.0, 0.0, 0.0, 1.0]
+    ev = {e.name: e.frame for e in detect_events(sim.spec, facts)}
+    assert ev["press"] == ev["turn_on"] == 3
+
+
+def test_door_fact_is_the_hinge_fraction_and_opening_events_follow_it(sim_env):
+    from rover.sim.facts import detect_events, frame_facts
+
+    sim = sim_env("Door")
+    sim.reset(0)
+    goal = sim.spec.goals["door_open"].angle
+    facts = []
+    for frac in (0.0, 0.02, 0.3, 0.95):
+        s = sim.get_state()
+        s[1 + sim.env.hinge_qpos_addr] = frac * goal
+        sim.set_state(s)
+        assert sim.joint_fraction("door") == pytest.approx(frac, abs=1e-6)
+        facts.append(frame_facts(sim))
+    assert [f.articulations["door"] for f in facts] == [0.0, 0.02, 0.3, 0.95]
+    ev = {e.name: e.frame for e in detect_events(sim.spec, facts) if e.object == "door"}
+    assert ev["open_start"] == 2 and ev["open_finish"] == 3 and ev["grasp"] is None
