@@ -126,7 +126,12 @@ def _summary(console: Console, trace: Trace, out: Path) -> None:
     t = trace.totals
     final = trace.progress()[-1] if trace.frames else 0.0
     label = " [bold yellow]ORACLE[/] (answers from ground truth, not a VLM)" if trace.oracle else ""
-    cached = f"; {t.cached_prompt_tokens:,} of the prompt cached" if t.cached_prompt_tokens else ""
+    # the provider's prompt-prefix cache, not rover's response cache counted in "calls"
+    cached = (
+        f"; {t.cached_prompt_tokens:,} in the provider's prefix cache"
+        if t.cached_prompt_tokens
+        else ""
+    )
     console.print(
         f"[bold]{esc(trace.method)}[/] on {esc(trace.episode_id)}: {trace.num_frames} frames, "
         f"{t.calls} calls ({t.cached_calls} cached), {t.total_tokens:,} tokens "
