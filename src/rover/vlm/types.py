@@ -71,16 +71,20 @@ class EncodedImage(BaseModel):
             arr = np.ascontiguousarray(image)
             if arr.dtype != np.uint8:
                 raise ValueError(f"image arrays must be uint8, got {arr.dtype}")
-            pixel_key = hashlib.sha256(arr.tobytes() + str(arr.shape).encode()).hexdigest()
         else:
             arr = None
             image = image.convert("RGB")
-            pixel_key = hashlib.sha256(image.tobytes() + str(image.size).encode()).hexdigest()
-        memo_key = (pixel_key, enc.model_dump_json())
-        hit = _ENCODED.get(memo_key) if memo else None
-        if hit is not None:
-            _ENCODED.move_to_end(memo_key)
-            return hit
+        memo_key = None
+        if memo:  # the pixels' hash is the memo's key: not computed when it is not used
+            if arr is not None:
+                pixel_key = hashlib.sha256(arr.tobytes() + str(arr.shape).encode()).hexdigest()
+            else:
+                pixel_key = hashlib.sha256(image.tobytes() + str(image.size).encode()).hexdigest()
+            memo_key = (pixel_key, enc.model_dump_json())
+            hit = _ENCODED.get(memo_key)
+            if hit is not None:
+                _ENCODED.move_to_end(memo_key)
+                return hit
         pil = Image.fromarray(arr) if arr is not None else image
         if pil.mode not in ("RGB", "L"):
             pil = pil.convert("RGB")  # JPEG has no alpha channel
@@ -100,7 +104,7 @@ class EncodedImage(BaseModel):
             height=pil.height,
             sha256=hashlib.sha256(data).hexdigest(),
         )
-        if not memo:
+        if memo_key is None:
             return out
         _ENCODED[memo_key] = out
         while len(_ENCODED) > _ENCODED_MAX:
