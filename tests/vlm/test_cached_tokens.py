@@ -94,3 +94,23 @@ def test_a_method_run_records_them_and_every_cost_view_splits_them(
     )
     no_hits = [{**r, "cached_prompt_tokens": 0} for r in rows]
     assert prompt_cache_line({**metrics, "cost": cost_table(no_hits)}) is None
+
+
+def test_rover_reason_names_the_providers_cached_part(openai_server, tmp_path):
+    import numpy as np
+    from typer.testing import CliRunner
+
+    from rover.cli import app
+    from rover.io.video import write_video
+
+    frames = np.zeros((4, 32, 32, 3), dtype=np.uint8)
+    for t in range(4):
+        frames[t, 8:16, 6 * t : 6 * t + 8] = 255
+    write_video(tmp_path / "v.mp4", frames, fps=5)
+    openai_server.answer = lambda body: "Frame description: x\nTask completion percentage: 20%"
+    openai_server.script(*[Reply(cached_tokens=50)] * 3)
+    args = ["reason", str(tmp_path / "v.mp4"), "--task", "push", "--method", "temporal-concat"]
+    args += ["--backend", f"openai:m@{openai_server.base_url}", "--no-cache"]
+    res = CliRunner().invoke(app, [*args, "--out", str(tmp_path / "t.json")])
+    assert res.exit_code == 0, res.output
+    assert "150 in the provider's prefix cache" in " ".join(res.output.split())
