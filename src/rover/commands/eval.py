@@ -244,6 +244,11 @@ def eval_command(
         )
 
     ex = make_executor(executor, address=ray_address, env_keys=key_env_names(config))
+    for name in getattr(ex, "missing_env", []):
+        err.print(
+            f"[yellow]warning:[/] {name} is set here but not on the Ray cluster's workers, "
+            "which read keys from their own environment (docs/distributed.md)"
+        )
     runner = prepare_run(opts, on_update, executor=ex)
     with ex, progress:
         state, metrics = asyncio.run(finish_run(runner))

@@ -119,6 +119,7 @@ def generate_command(
     )
     check_output_dir(out, "--out", marker="dataset.json")
     _check_resume(out, cfg)
+    ex = make_executor(executor, workers=workers, address=ray_address)
     logging.getLogger("robosuite").setLevel(logging.ERROR)
     console = make_console(stderr=True)
     start = time.perf_counter()
@@ -138,7 +139,6 @@ def generate_command(
                 )
             bar.update(ids[stage], completed=done, total=total)
 
-        ex = make_executor(executor, workers=workers, address=ray_address)
         written = generate(cfg, out, workers=workers, on_progress=on_progress, executor=ex)
     took = time.perf_counter() - start
     console.print(f"wrote {len(written)} episodes to {esc(out)} in {took:.1f}s")

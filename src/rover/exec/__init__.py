@@ -57,12 +57,14 @@ def make_executor(
     """The executor `--executor KIND` names (checked first; see `check_executor`).
 
     `workers` sizes the local pool; for Ray the cluster's resources decide. `env_keys` are
-    names of environment variables (API keys) that Ray workers on other nodes need; they
-    travel in the job's runtime environment, never in task arguments.
+    names of environment variables (API keys) that workers read; on an existing cluster,
+    those set here but unset on a worker end up in `executor.missing_env` (never values).
     """
     check_executor(kind, address)
     if kind == "local":
         return LocalExecutor(workers)
     from rover.exec.ray_cluster import RayExecutor
 
-    return RayExecutor(address=address, env_keys=env_keys)
+    executor = RayExecutor(address=address, env_keys=env_keys)
+    executor.start()  # connect now: an unreachable cluster is refused before any work
+    return executor

@@ -4,9 +4,10 @@ Tasks never write into the driver's output directory: a Ray worker may run on a 
 does not mount it, so every task returns its results (bytes, or the pydantic objects the
 local code would have saved) and the driver writes them with the same atomic temp+rename
 the local executor uses. Inputs travel through the object store (`put`), so worker nodes
-need rover installed but no shared filesystem. API keys never travel as task arguments:
-workers read them from their own environment (a local Ray inherits the driver's; on an
-existing cluster the named variables go into the job's runtime environment).
+need rover installed but no shared filesystem. API keys never travel at all: workers
+read them from their own environment. A local Ray inherits the driver's; an existing
+cluster's nodes must have them set (not forwarded through Ray's runtime environment,
+because Ray's runtime-env agent writes those values into its log files on every node).
 """
 
 from __future__ import annotations
@@ -22,8 +23,13 @@ from rover.errors import InputError, RoverError
 # A work unit of `rover eval` mostly waits on its VLM endpoint: half a CPU each lets two
 # units share a core; endpoint budgets (below), not CPUs, bound the calls in flight.
 EVAL_UNIT_CPUS = 0.5
-# passed to workers on an existing cluster when set here (offscreen rendering backend)
+# passed to workers on an existing cluster when set here (offscreen rendering; no secrets)
 FORWARDED_ENV = ("MUJOCO_GL", "PYOPENGL_PLATFORM")
+
+
+def unset_names(names: tuple[str, ...]) -> list[str]:
+    """Which of these environment variables are unset here (names only, never values)."""
+    return [n for n in names if not os.environ.get(n)]
 
 
 class EndpointBudget:
@@ -69,6 +75,24 @@ def _task_error(exc: BaseException) -> BaseException:
     return RoverError(f"a Ray task failed: {first[:300]}")
 
 
+def _check_reachable(address: str) -> None:
+    """A host:port that refuses connections fails in seconds (Ray itself waits minutes)."""
+    import socket
+
+    if address == "auto":
+        return  # Ray finds the local cluster's address itself, and says if there is none
+    hostport = address.split("://", 1)[-1].rstrip("/")
+    host, _, port = hostport.rpartition(":")
+    if not host or not port.isdigit():
+        raise InputError(
+            f"--ray-address {address!r}: give 'auto' or host:port (e.g. 10.0.0.5:6379)"
+        )
+    try:
+        socket.create_connection((host, int(port)), timeout=5).close()
+    except OSError as exc:
+        raise InputError(f"--ray-address {address}: no Ray cluster answers there ({exc})") from None
+
+
 class RayExecutor:
     """Runs tasks on Ray: a fresh local instance (`address=None`) or an existing cluster.
 
@@ -88,19 +112,25 @@ class RayExecutor:
     ) -> None:
         self.address = address
         self.env_keys = tuple(env_keys)
+        # key variables set here but not on a cluster worker (filled in by `start`)
+        self.missing_env: list[str] = []
         self.num_cpus = num_cpus
         self._owns = False
         self._started = False
+        self._depth = 0
         self._remotes: dict[tuple[Callable[..., Any], float], Any] = {}
         self._budgets: dict[str, Any] = {}
 
     # --- lifecycle --------------------------------------------------------------------
     def __enter__(self) -> RayExecutor:
         self.start()
+        self._depth += 1
         return self
 
     def __exit__(self, *exc: object) -> None:
-        self.close()
+        self._depth -= 1
+        if self._depth <= 0:  # nested `with` blocks (a caller's and generate's) share one Ray
+            self.close()
 
     def start(self) -> None:
         import ray
@@ -115,12 +145,15 @@ class RayExecutor:
             "logging_level": logging.WARNING,
         }
         if self.address:
-            env = {k: os.environ[k] for k in (*self.env_keys, *FORWARDED_ENV) if os.environ.get(k)}
-            if env:  # values go to the cluster's job config, never into task arguments
+            _check_reachable(self.address)
+            env = {k: os.environ[k] for k in FORWARDED_ENV if os.environ.get(k)}
+            if env:
                 kwargs["runtime_env"] = {"env_vars": env}
             kwargs["address"] = self.address
-        elif self.num_cpus is not None:
-            kwargs["num_cpus"] = self.num_cpus
+        else:  # always a new instance, even if this machine also belongs to a cluster
+            kwargs["address"] = "local"
+            if self.num_cpus is not None:
+                kwargs["num_cpus"] = self.num_cpus
         try:
             ray.init(**kwargs)
         except (ConnectionError, RuntimeError, ValueError) as exc:
@@ -128,6 +161,10 @@ class RayExecutor:
             line = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
             raise InputError(f"--ray-address {where}: cannot start or reach Ray ({line})") from None
         self._owns = True
+        here = tuple(k for k in self.env_keys if os.environ.get(k))
+        if self.address and here:  # a worker of the cluster, asked for names only
+            probe = ray.remote(num_cpus=0)(unset_names)
+            self.missing_env = ray.get(probe.remote(here))
 
     def close(self) -> None:
         import ray
