@@ -160,3 +160,32 @@ async def test_stream_replays_rover_reason_prompt_for_prompt(
     offline = Trace.load(out)
     live, _, _ = await stream_video(ep, load_vlm(f"replay:{cassette}"))
     assert_same_trace(live, offline)
+
+
+async def test_unrecorded_stream_keeps_memory_bounded_and_same_estimates(
+    make_episode, scripted, chatty
+):
+    """record=False: the same estimates and totals, with nothing kept per frame."""
+    ep = make_episode(40)
+    full, lean = (
+        RoverStream(TASK, scripted(chatty)),
+        RoverStream(TASK, scripted(chatty), record=False),
+    )
+    for frame in ep.frames():
+        a, b = await full.push(frame), await lean.push(frame)
+        assert (a.progress, a.subtask_path, a.description, a.calls) == (
+            b.progress,
+            b.subtask_path,
+            b.description,
+            b.calls,
+        )
+        s = lean._session
+        assert len(s.trace.frames.items) <= 6 and len(s.trace.frame_indices.items) <= 6
+        assert list(s.trace.calls) == []  # counted, not kept
+    kept, summary = await full.trace(), await lean.trace()
+    assert summary.frames == [] and summary.calls == [] and summary.num_frames == 40
+    assert summary.totals.model_dump(exclude={"latency_s"}) == kept.totals.model_dump(
+        exclude={"latency_s"}
+    )
+    assert summary.tree == kept.tree
+    assert summary.params["record"] is False

@@ -63,6 +63,9 @@ class RoverStream:
             replayed as a stream; ignored by backends that read pixels.
         episode_id, view: recorded in the trace (default: the bound episode's, else
             "stream" and no view).
+        record: keep every frame and call record for `trace()` (default). False keeps
+            memory flat however long the stream runs: `trace()` is then a summary (totals
+            and the tree of lines; no per-frame records, no calls).
         **params: ROVER's parameters (window, threshold, max_depth, ..., as `get_method`).
     """
 
@@ -75,6 +78,7 @@ class RoverStream:
         episode_id: str | None = None,
         view: str | None = None,
         method: str = "rover",
+        record: bool = True,
         **params: Any,
     ) -> None:
         from rover.methods.registry import get_method
@@ -97,6 +101,7 @@ class RoverStream:
         self.vlm = vlm
         self.task = task
         self._episode_id, self._view = episode_id or "stream", view
+        self.record = record
         self._session: LiveSession | None = None
         self._job: asyncio.Task | None = None
         self._root: Any = None
@@ -154,7 +159,7 @@ class RoverStream:
         s.close()
         assert self._job is not None
         await self._job
-        self._final = self.method.stitched(s, self._root)
+        self._final = self.method.stitched(s, self._root) if self.record else _summary(s, self)
         return self._final
 
     async def aclose(self) -> None:
@@ -171,7 +176,13 @@ class RoverStream:
     def _start(self) -> LiveSession:
         if self._session is None:
             s = LiveSession(
-                self.method, self.vlm, self.task, self._on_step, self._episode_id, self._view
+                self.method,
+                self.vlm,
+                self.task,
+                self._on_step,
+                self._episode_id,
+                self._view,
+                record=self.record,
             )
             self._session = s
             self._job = asyncio.get_running_loop().create_task(self._reason(s))
@@ -194,6 +205,30 @@ class RoverStream:
                 waiter.cancel()
         if self._job.done() and not self._job.cancelled() and self._job.exception():
             raise self._job.exception()  # type: ignore[misc]
+
+
+def _summary(s: LiveSession, stream: RoverStream) -> Trace:
+    """The trace of a stream that kept no records: its totals and its tree of lines."""
+    from datetime import UTC, datetime
+
+    t = s.trace
+    return Trace(
+        method=t.method,
+        params={**t.params, "record": False},
+        backend=t.backend,
+        model=t.model,
+        oracle=t.oracle,
+        episode_id=t.episode_id,
+        task=t.task,
+        view=t.view,
+        num_frames=s.num_frames,
+        frame_indices=[],
+        frames=[],
+        tree=stream._root.node,
+        totals=s.totals(),
+        started_at=t.started_at,
+        finished_at=datetime.now(UTC).isoformat(),
+    )
 
 
 def _check_frame(frame: Any) -> np.ndarray:
