@@ -169,3 +169,17 @@ def test_bad_watch_input_is_one_line(tmp_path):
         res = subprocess.run([*cmd, *args], capture_output=True, text=True, env=env(), timeout=60)
         assert res.returncode == 2 and msg in res.stderr, res.stderr
         assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_status_line_is_literal_safe_and_fits():
+    from rover.commands.watch import status_line
+    from rover.stream.rover_stream import FrameEstimate
+
+    hostile = ["[bold red]grab[/] \x1b]0;pwned\x07 the can", "x" * 200]
+    est = FrameEstimate(position=9, index=9, progress=45.0, subtask_path=hostile, calls=1)
+    text = status_line(est, 10, 31)
+    assert len(text.plain) <= 80 and "\x1b" not in text.plain and "\x07" not in text.plain
+    assert text.plain.startswith("  10 frames [#####       ]  45.0%  ")
+    assert text.plain.endswith("  31 calls") and "xxx" in text.plain  # innermost kept
+    short = status_line(FrameEstimate(0, 0, 100.0, ["[b]a[/b]"], complete=True), 1, 2)
+    assert "[b]a[/b]" in short.plain and short.plain.endswith("2 calls  done")
