@@ -8,7 +8,10 @@ private `MjData` (so rendering never disturbs the simulation). Views:
 - ``left`` / ``right``: free cameras beside the robot, on its left and on its right,
   looking past the arm at the task (no model edit needed, so robosuite/RoboCasa models
   load as is). The generator aims them at the task's centre (`view_centre`: gripper,
-  objects and goals at the start), so every task's objects and gripper are in frame.
+  objects and goals at the start), so every task's objects and gripper are in frame,
+  and each view swings round or rises (`aim_views`) until nothing but the robot stands
+  between it and the gripper or the task's centre at the video's start and end (from
+  the robot's right, robosuite's Door panel hides the handle and the hand).
 - any camera name in the model (``frontview``, ``agentview``, ...) also works.
 
 Cost is geometry-bound on a CPU rasteriser, so multisampling is off, the offscreen buffer
@@ -51,6 +54,18 @@ FREE_VIEWS: dict[str, FreeView] = {
     "right": FreeView(lookat=(0.0, 0.0, 0.9), distance=1.45, azimuth=60.0, elevation=-30.0),
 }
 VIEW_NAMES = ["wrist", "left", "right"]
+GRIP_SITE = "gripper0_right_grip_site"  # robosuite's Panda grip point (between the fingers)
+# (azimuth, elevation) tried for each free view, its default first: swung toward the side
+# of the table, then toward the front, then raised (the first one that sees the gripper
+# and the task's centre unhidden is used)
+AIM_CANDIDATES: dict[str, list[tuple[float, float]]] = {
+    name: [
+        (sign * az, el)
+        for az, el in ((60, -30), (75, -30), (45, -30), (90, -35), (30, -35), (60, -50), (90, -55))
+    ]
+    for name, sign in (("left", -1.0), ("right", 1.0))
+}
+SEEN_SLACK = 0.06  # m: a hit this close before a point is the point's own surface
 
 
 def check_views(views: list[str]) -> None:
@@ -76,7 +91,11 @@ class StateRenderer:
         self.option = mujoco.MjvOption()
         self.option.geomgroup[0] = 0
 
-    def camera(self, view: str, lookat: np.ndarray | None = None) -> mujoco.MjvCamera | int:
+    def camera(
+        self, view: str, lookat: np.ndarray | None = None, aim: FreeView | None = None
+    ) -> mujoco.MjvCamera | int:
+        """The camera of a view; ``aim`` (from `aim_views`) replaces a free view's
+        default distance, azimuth and elevation."""
         if view == "wrist":
             view = WRIST_CAMERA
         # a model may carry its own camera for a view (the kitchen's, jittered per scene)
@@ -84,7 +103,7 @@ class StateRenderer:
         if own >= 0:
             return own
         if view in FREE_VIEWS:
-            fv = FREE_VIEWS[view]
+            fv = aim or FREE_VIEWS[view]
             cam = mujoco.MjvCamera()
             cam.type = mujoco.mjtCamera.mjCAMERA_FREE
             cam.lookat[:] = fv.lookat if lookat is None else lookat
@@ -108,9 +127,13 @@ class StateRenderer:
         self, states: np.ndarray, views: list[str], lookat: np.ndarray | None = None
     ) -> dict[str, np.ndarray]:
         """Frames (T, H, W, 3) uint8 per view for each state in order; free views look at
-        `lookat` (default: the table centre)."""
+        `lookat` (default: the table centre), from where `aim_views` sees the gripper and
+        `lookat` unhidden in the first and last state."""
         check_views(views)
-        cams = {v: self.camera(v, lookat) for v in views}
+        aims: dict[str, FreeView] = {}
+        if lookat is not None and len(states):
+            aims = self.aim_views(np.asarray(states)[[0, -1]], lookat)
+        cams = {v: self.camera(v, lookat, aims.get(v)) for v in views}
         out = {v: np.empty((len(states), self.height, self.width, 3), np.uint8) for v in views}
         for t, state in enumerate(states):
             self.set_state(np.asarray(state, dtype=np.float64))
@@ -122,26 +145,100 @@ class StateRenderer:
                 out[v][t] = self.renderer.render()
         return out
 
+    def aim_views(
+        self, states: np.ndarray, lookat: np.ndarray, points: list[np.ndarray] | None = None
+    ) -> dict[str, FreeView]:
+        """For each free view, the first of its `AIM_CANDIDATES` from which the gripper,
+        `lookat` and any extra world ``points`` are in frame and hidden by nothing but the
+        robot in every given state; the candidate that sees most of them when none sees
+        all (a free view the model defines itself is left alone)."""
+        grip = int(mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, GRIP_SITE))
+        out: dict[str, FreeView] = {}
+        for view, base in FREE_VIEWS.items():
+            own = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, f"rover_{view}")
+            if own >= 0:
+                continue
+            best, best_seen = None, -1
+            for az, el in AIM_CANDIDATES[view]:
+                fv = FreeView(tuple(float(x) for x in lookat), base.distance, az, el)
+                seen = 0
+                for state in states:
+                    self.set_state(np.asarray(state, dtype=np.float64))
+                    targets = [np.asarray(lookat, dtype=np.float64), *(points or [])]
+                    if grip >= 0:
+                        targets.append(self.data.site_xpos[grip].copy())
+                    seen += sum(self._seen(fv, p) for p in targets)
+                if seen > best_seen:
+                    best, best_seen = fv, seen
+                if seen == len(states) * len(targets):
+                    break
+            if best is not None:
+                out[view] = best
+        return out
+
+    def _seen(self, fv: FreeView, point: np.ndarray) -> bool:
+        """In frame of `fv` and not hidden by any geom but the robot's (posed data)."""
+        if not _in_frame(fv, point):
+            return False
+        cam = camera_position(fv)
+        ray = point - cam
+        length = float(np.linalg.norm(ray))
+        unit = ray / length
+        gid = np.array([-1], dtype=np.int32)
+        travelled = 0.0
+        for _ in range(32):  # step through the robot's own geoms
+            start = cam + unit * travelled
+            dist = mujoco.mj_ray(self.model, self.data, start, unit, None, 1, -1, gid)
+            if dist < 0 or travelled + dist >= length - SEEN_SLACK:
+                return True
+            body = mujoco.mj_id2name(
+                self.model, mujoco.mjtObj.mjOBJ_BODY, int(self.model.geom_bodyid[gid[0]])
+            )
+            if not (body or "").startswith(("robot0_", "gripper0_", "mount0_")):
+                return False
+            travelled += dist + 1e-3
+        return True
+
     def close(self) -> None:
         self.renderer.close()
 
 
-def in_view(view: str, lookat: np.ndarray, point: np.ndarray, fovy: float = 45.0) -> bool:
-    """Whether a world point falls inside a square frame of free view `view` aimed at
-    `lookat` (pinhole projection with MuJoCo's free-camera geometry and vertical fovy)."""
-    fv = FREE_VIEWS[view]
+def camera_position(fv: FreeView) -> np.ndarray:
+    """Where MuJoCo puts a free camera: lookat - distance * forward."""
+    return np.asarray(fv.lookat, dtype=np.float64) - fv.distance * _forward(fv)
+
+
+def _forward(fv: FreeView) -> np.ndarray:
     az, el = np.radians(fv.azimuth), np.radians(fv.elevation)
-    fwd = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
-    pos = np.asarray(lookat, dtype=np.float64) - fv.distance * fwd
+    return np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+
+
+def _in_frame(fv: FreeView, point: np.ndarray, fovy: float = 45.0) -> bool:
+    fwd = _forward(fv)
     right = np.cross(fwd, [0.0, 0.0, 1.0])
     right /= np.linalg.norm(right)
     up = np.cross(right, fwd)
-    v = np.asarray(point, dtype=np.float64) - pos
+    v = np.asarray(point, dtype=np.float64) - camera_position(fv)
     depth = float(v @ fwd)
     if depth <= 0:
         return False
     half = np.tan(np.radians(fovy) / 2)
     return abs(v @ right) / depth < half and abs(v @ up) / depth < half
+
+
+def in_view(
+    view: str,
+    lookat: np.ndarray,
+    point: np.ndarray,
+    fovy: float = 45.0,
+    aim: FreeView | None = None,
+) -> bool:
+    """Whether a world point falls inside a square frame of free view `view` aimed at
+    `lookat` (pinhole projection with MuJoCo's free-camera geometry and vertical fovy);
+    ``aim`` (from `StateRenderer.aim_views`) replaces the view's default placement."""
+    base = aim or FREE_VIEWS[view]
+    fv = FreeView(tuple(float(x) for x in lookat), base.distance, base.azimuth, base.elevation)
+    return _in_frame(fv, point, fovy)
 
 
 def view_centre(sim) -> np.ndarray:
