@@ -29,6 +29,9 @@ def _closed_port_url() -> str:
 
 
 def _ask_many(vlm, prompts):
+    """Ask concurrently. Tests that count requests per replica give a long timeout: the
+    SDK's first request imports its resource modules, which takes seconds on a busy CPU."""
+
     async def go():
         try:
             return await asyncio.gather(*(vlm.complete(p) for p in prompts))
@@ -43,7 +46,7 @@ def _prompts(make_prompt, n: int):
 
 
 def test_equal_replicas_share_concurrent_calls_evenly(fast_config, make_prompt):
-    config = fast_config.model_copy(update={"concurrency": 8, "no_cache": True})
+    config = fast_config.model_copy(update={"concurrency": 8, "no_cache": True, "timeout_s": 60.0})
     with OpenAICompatServer() as a, OpenAICompatServer() as b:
         for s, name in ((a, "A"), (b, "B")):
             s.answer = lambda body, name=name: f"from {name}"
@@ -56,7 +59,7 @@ def test_equal_replicas_share_concurrent_calls_evenly(fast_config, make_prompt):
 
 
 def test_a_slow_replica_gets_fewer_calls(fast_config, make_prompt):
-    config = fast_config.model_copy(update={"concurrency": 2, "no_cache": True})
+    config = fast_config.model_copy(update={"concurrency": 2, "no_cache": True, "timeout_s": 60.0})
     with OpenAICompatServer() as slow, OpenAICompatServer() as fast:
         slow.script(*[Reply(delay_s=1.0)] * 10)
         vlm = load_vlm(f"openai:m@{slow.base_url},{fast.base_url}", config)
@@ -97,9 +100,12 @@ def test_a_replica_that_times_out_is_failed_over_within_one_call(fast_config, ma
     with OpenAICompatServer() as stuck, OpenAICompatServer() as good:
         stuck.script(Reply(delay_s=3.0))
         good.answer = lambda body: "in time"
+        # warm the SDK up first (its first request imports modules: seconds on a busy CPU)
+        warm = fast_config.model_copy(update={"no_cache": True, "timeout_s": 60.0})
+        _ask_many(load_vlm(f"openai:m@{good.base_url}", warm), [make_prompt("warm-up")])
         vlm = load_vlm(f"openai:m@{stuck.base_url},{good.base_url}", config)
         (out,) = _ask_many(vlm, [make_prompt("hello?")])
-        assert out.text == "in time" and (stuck.count, good.count) == (1, 1)
+        assert out.text == "in time" and (stuck.count, good.count) == (1, 2)
         assert vlm.pool.replicas[0].failures == 1
 
 
@@ -216,3 +222,32 @@ def test_a_pool_nobody_answers_fails_with_one_line_naming_it(fast_config, make_p
     message = str(err.value)
     assert "cannot connect to the pool (http://127.0.0.1:" in message
     assert "dead-pw" not in message and "\n" not in message
+
+
+def test_three_replicas_one_failing_one_slow_under_concurrency(fast_config, make_prompt):
+    config = fast_config.model_copy(update={"concurrency": 3, "no_cache": True, "timeout_s": 60.0})
+    with OpenAICompatServer() as bad, OpenAICompatServer() as slow, OpenAICompatServer() as ok:
+        bad.script(*[Reply(status=502, text="bad gateway")] * 20)
+        slow.script(*[Reply(delay_s=0.8)] * 20)
+        for s, name in ((slow, "slow"), (ok, "ok")):
+            s.answer = lambda body, name=name: name
+        vlm = load_vlm(f"openai:m@{bad.base_url},{slow.base_url},{ok.base_url}", config)
+        out = _ask_many(vlm, _prompts(make_prompt, 12))
+        assert len(out) == 12 and {c.text for c in out} <= {"slow", "ok"}
+        assert bad.count == 1  # failed over at once, then cooled down
+        assert slow.count < ok.count and slow.count + ok.count == 12
+        assert max(slow.max_in_flight, ok.max_in_flight) <= 3  # --concurrency bounds the pool
+
+
+def test_a_pool_whose_replicas_all_time_out_says_so(fast_config, make_prompt):
+    config = fast_config.model_copy(update={"no_cache": True, "timeout_s": 0.3})
+    with OpenAICompatServer() as a, OpenAICompatServer() as b:
+        warm = config.model_copy(update={"timeout_s": 60.0})
+        _ask_many(load_vlm(f"openai:m@{a.base_url}", warm), [make_prompt("warm-up")])
+        for s in (a, b):
+            s.script(*[Reply(delay_s=2.0)] * 4)
+        vlm = load_vlm(f"openai:m@{a.base_url},{b.base_url}", config)
+        with pytest.raises(BackendError, match=r"no answer within 0.3 s"):
+            _ask_many(vlm, [make_prompt("x")])
+        # one failover per attempt; the timeout budget (1 retry) bounds the attempts
+        assert a.count + b.count - 1 <= 4

@@ -9,6 +9,7 @@ The SDK's own retries are off (`max_retries=0`): our shared loop retries instead
 from __future__ import annotations
 
 import base64
+import dataclasses
 import os
 from typing import Any
 
@@ -130,13 +131,7 @@ class OpenAIBackend(BaseBackend):
         if self.pool is None:
             return policy
         # the pool times each replica's attempt itself, so a failover gets a fresh timeout
-        return RetryPolicy(
-            max_retries=policy.max_retries,
-            timeout_s=None,
-            base_wait_s=policy.base_wait_s,
-            max_wait_s=policy.max_wait_s,
-            timeout_retries=policy.timeout_retries,
-        )
+        return dataclasses.replace(policy, wrap_timeout=False)
 
     def _client(self, base_url: str | None = None) -> Any:
         url = base_url or self.base_url

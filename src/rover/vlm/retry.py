@@ -85,6 +85,9 @@ class RetryPolicy:
     max_wait_s: float = 60.0
     # retries after a timeout (each costs a whole timeout_s; a silent server stays silent)
     timeout_retries: int = 1
+    # False: the call times its own attempts (an endpoint pool times each replica, so a
+    # failover gets a fresh timeout); timeout_s then only names the limit in messages
+    wrap_timeout: bool = True
 
 
 def parse_retry_after(headers: Any) -> float | None:
@@ -146,13 +149,14 @@ async def call_with_retries(
     attempt = 0
     for attempt in range(attempts):
         try:
-            if policy.timeout_s is None:
+            if policy.timeout_s is None or not policy.wrap_timeout:
                 return await call()
             return await asyncio.wait_for(call(), timeout=policy.timeout_s)
         except TimeoutError:
+            within = f" within {policy.timeout_s:g} s" if policy.timeout_s is not None else ""
             info = ErrorInfo(
                 ErrorKind.transient,
-                f"no answer within {policy.timeout_s:g} s (raise it with --timeout)",
+                f"no answer{within} (raise it with --timeout)",
                 retry_limit=policy.timeout_retries,
                 group="timeout",
             )
