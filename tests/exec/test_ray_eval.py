@@ -1,6 +1,6 @@
 """`rover eval --executor ray` writes what the local runner writes, on a local Ray.
 
-Two bundled episodes (real simulator truth, QA questions), against the oracle and against
+Bundled episodes (real simulator truth, QA questions), against the oracle and against
 a loopback OpenAI-compatible server answering like a chatty model (markdown, prose). The
 metrics must equal the local run's, except per-call latency, which differs between two
 local runs too. The server also checks the endpoint budget (calls in flight, counted at
@@ -26,10 +26,11 @@ from .conftest import WORKER_KEY
 runner = CliRunner()
 
 
-def _eval(out: Path, *args: str) -> str:
+def _eval(out: Path, *args: str, limit: int = 2) -> str:
     res = runner.invoke(
         app,
-        ["eval", "--dataset", "bundled", "--limit", "2", "--no-cache", "--out", str(out), *args],
+        ["eval", "--dataset", "bundled", "--limit", str(limit), "--no-cache", "--out", str(out)]
+        + list(args),
         catch_exceptions=False,
     )
     assert res.exit_code == 0, res.output
@@ -111,15 +112,15 @@ def test_loopback_eval_on_ray_equals_local_within_the_endpoint_budget(
             "--backend", spec, "--methods", "rover,temporal-concat",
             "--judge", spec, "--answerer", spec,
         )  # fmt: skip
-        _eval(tmp_path / "local", *common)
+        _eval(tmp_path / "local", *common, limit=1)
         local_keys = set(server.keys_seen)
         server.keys_seen.clear()
         server.max_in_flight = 0
-        _eval(tmp_path / "ray", *common, "--executor", "ray", "--calls-in-flight", "1")
-        assert server.max_in_flight == 1  # four units on Ray workers, one call at a time
+        _eval(tmp_path / "ray", *common, "--executor", "ray", "--calls-in-flight", "1", limit=1)
+        assert server.max_in_flight == 1  # two units on Ray workers, one call at a time
         ray_keys = set(server.keys_seen)
     local, ray_m = _metrics(tmp_path / "local"), _metrics(tmp_path / "ray")
-    assert ray_m["counts"]["traces"] == 4 and ray_m["counts"]["failed"] == 0
+    assert ray_m["counts"]["traces"] == 2 and ray_m["counts"]["failed"] == 0
     assert ray_m == local
     # the key reached the server from the workers' own environment, not from this process
     assert any(WORKER_KEY in k for k in ray_keys) and not any(WORKER_KEY in k for k in local_keys)
