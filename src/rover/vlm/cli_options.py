@@ -46,7 +46,10 @@ from pydantic import ValidationError
 from rover.errors import InputError
 from rover.vlm.config import BackendConfig
 
-VLM_HELP = "VLM spec: openai:<model>[@<base_url>], gemini:<model>, hf:<path>, oracle, replay:<file>"
+VLM_HELP = (
+    "VLM spec: openai:<model>[@<url>[,<url>...]], gemini:<model>, hf:<path>, "
+    "oracle, replay:<file>"
+)
 
 VLMOpt = Annotated[str, typer.Option("--vlm", help=VLM_HELP)]
 CacheOpt = Annotated[

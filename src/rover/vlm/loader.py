@@ -1,6 +1,7 @@
 """`load_vlm(spec)`: turn a spec string into a ready backend.
 
-Spec strings: `openai:<model>[@<base_url>]`, `gemini:<model>[@<base_url>]`, `hf:<path>`,
+Spec strings: `openai:<model>[@<base_url>]` (several comma-separated URLs: a pool of
+replicas, see `rover.vlm.pool`), `gemini:<model>[@<base_url>]`, `hf:<path>`,
 `oracle`, `replay:<cassette>`. Each provider module (and its SDK) is imported only when
 its spec is used, so `import rover.vlm` stays cheap and missing extras fail with an
 install hint instead of an ImportError.
@@ -18,7 +19,7 @@ if TYPE_CHECKING:
     from rover.vlm.types import VLM
 
 SPEC_FORMS = (
-    "openai:<model>[@<base_url>]",
+    "openai:<model>[@<base_url>[,<base_url>...]]",
     "gemini:<model>[@<base_url>]",
     "hf:<path>",
     "oracle",
