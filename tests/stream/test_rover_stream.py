@@ -189,3 +189,4 @@ async def test_unrecorded_stream_keeps_memory_bounded_and_same_estimates(
     )
     assert summary.tree == kept.tree
     assert summary.params["record"] is False
+    assert Trace.model_validate_json(summary.model_dump_json()) == summary  # saves and loads

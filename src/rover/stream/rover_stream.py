@@ -211,23 +211,17 @@ def _summary(s: LiveSession, stream: RoverStream) -> Trace:
     """The trace of a stream that kept no records: its totals and its tree of lines."""
     from datetime import UTC, datetime
 
-    t = s.trace
-    return Trace(
-        method=t.method,
-        params={**t.params, "record": False},
-        backend=t.backend,
-        model=t.model,
-        oracle=t.oracle,
-        episode_id=t.episode_id,
-        task=t.task,
-        view=t.view,
-        num_frames=s.num_frames,
-        frame_indices=[],
-        frames=[],
-        tree=stream._root.node,
-        totals=s.totals(),
-        started_at=t.started_at,
-        finished_at=datetime.now(UTC).isoformat(),
+    return s.trace.model_copy(
+        update={
+            "params": {**s.trace.params, "record": False},
+            "num_frames": s.num_frames,
+            "frame_indices": [],
+            "frames": [],
+            "calls": [],
+            "tree": stream._root.node,
+            "totals": s.totals(),
+            "finished_at": datetime.now(UTC).isoformat(),
+        }
     )
 
 
