@@ -94,7 +94,7 @@ def _check_reachable(address: str) -> None:
 
 
 class RayExecutor:
-    """Runs tasks on Ray: a fresh local instance (`address=None`) or an existing cluster.
+    """Runs tasks on Ray: a fresh local instance (no address, no `RAY_ADDRESS`) or a cluster.
 
     If Ray is already initialised in this process (a notebook, a test session), that
     session is used and left running on close.
@@ -110,7 +110,8 @@ class RayExecutor:
         env_keys: Iterable[str] = (),
         num_cpus: int | None = None,
     ) -> None:
-        self.address = address
+        # RAY_ADDRESS is Ray's own default (a `ray job submit` job has it set): honoured
+        self.address = address or os.environ.get("RAY_ADDRESS") or None
         self.env_keys = tuple(env_keys)
         # key variables set here but not on a cluster worker (filled in by `start`)
         self.missing_env: list[str] = []
@@ -157,9 +158,13 @@ class RayExecutor:
         try:
             ray.init(**kwargs)
         except (ConnectionError, RuntimeError, ValueError) as exc:
-            where = self.address or "a local Ray instance"
             line = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
-            raise InputError(f"--ray-address {where}: cannot start or reach Ray ({line})") from None
+            what = (
+                f"--ray-address {self.address}: cannot reach"
+                if self.address
+                else ("--executor ray: cannot start")
+            )
+            raise InputError(f"{what} Ray ({line})") from None
         self._owns = True
         here = tuple(k for k in self.env_keys if os.environ.get(k))
         if self.address and here:  # a worker of the cluster, asked for names only
