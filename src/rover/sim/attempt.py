@@ -10,6 +10,7 @@ accepted attempt is rendered.
 
 from __future__ import annotations
 
+import zlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,51 +22,44 @@ from rover.sim.tasks.base import TaskSpec
 
 MAX_TRIES = 12  # tries per episode before the best one is kept (and flagged)
 ENDINGS = 6  # final deviations drawn per planned prefix
-FLOOR_TOLERANCE = 0.05  # a level may end this far below the previous level's cut
+FLOOR_TOLERANCE = 0.05  # (no milestone marks) a level may end this far below the level under it
 TRY_STRIDE = 1_000_003  # plan index offset between attempts (independent Generators)
 RECOVERY_GAP = 0.015  # m an object may sit off the expert state a recovery hands over to
 HIGHEST_MIN_END = 0.95  # the top level must (almost) finish the task
-IDLE_POS = 0.002  # m: an expert step that moves no entity more than this is idle ...
-IDLE_GRIP = 0.01  # ... and changes the gripper opening less than this ...
-IDLE_JOINT = 0.01  # ... and no articulated joint (knob, drawer) moves this fraction of its range
 IDLE_KEEP = 2  # idle steps kept in a row (a short pause reads as a pause, not a stall)
 RETREAT_KEEP = 12  # expert steps kept after the task is done (the hand backs off)
+
+
+_MARKS: dict[str, dict] = {}  # task -> (demo, length, crc) -> ExpertMarks, per process
 
 
 def trim_demo(
     sim, states: np.ndarray, actions: np.ndarray, ends: list[int]
 ) -> tuple[np.ndarray, np.ndarray, list[int]]:
-    """Drop the expert's idle steps and the end of its retreat.
+    """Drop the expert's idle and creeping steps and the end of its retreat.
 
-    Scripted experts pause (fingers closing, settling, the final hold) and back off for a
-    while once the task is done; sampled evenly, those stretches become runs of identical
-    frames. A step is idle when no entity (hand, objects) moves more than `IDLE_POS` and
-    the gripper opening changes less than `IDLE_GRIP` and no subtask joint more than
-    `IDLE_JOINT` since the last kept step; at most `IDLE_KEEP` idle steps in a row are
-    kept, and `RETREAT_KEEP` steps after the last subtask's end. Subtask-end steps are
-    always kept; ends are remapped.
+    Scripted experts pause (fingers closing, settling, the final hold), slow down at the
+    end of every reach, and back off for a while once the task is done; sampled evenly
+    (densely, in a short video), those stretches become runs of frames in which nothing
+    visibly changes. A step is idle when, since the last kept step, nothing changes by
+    the audit's own test (`rover.sim.audit.facts_changed`: hand, objects, gripper
+    opening, joints), so what the trim keeps is exactly what the audit calls motion; at
+    most `IDLE_KEEP` idle steps in a row are kept, and `RETREAT_KEEP` steps after the
+    last subtask's end. Subtask-end steps are always kept; ends are remapped.
     """
+    from rover.sim.audit import facts_changed
+    from rover.sim.facts import facts_for_states
+
     n = len(states)
     last = min(n - 1, int(ends[-1]) + RETREAT_KEEP) if ends else n - 1
     must = set(int(e) for e in ends) | {0, last}
-    ents, grip, arts = [], [], []
-    # a knob turns on its axis (no point of it moves): its joint is watched as well
-    joints = sorted({s.joint for s in sim.spec.subtasks if getattr(s, "joint", None)})
     saved = sim.get_state()
-    for s in states[: last + 1]:
-        sim.set_state(s)
-        ents.append(sim.entity_positions())
-        grip.append(sim.gripper_opening())
-        arts.append(np.asarray([sim.point(j)[0] for j in joints], dtype=np.float64))
+    facts = facts_for_states(sim, states[: last + 1])
     sim.set_state(saved)
     keep = [0]
     idle = 0
     for t in range(1, last + 1):
-        ref = keep[-1]
-        moved = float(np.abs(ents[t] - ents[ref]).max()) > IDLE_POS
-        gripped = abs(grip[t] - grip[ref]) > IDLE_GRIP
-        turned = bool(joints) and float(np.abs(arts[t] - arts[ref]).max()) > IDLE_JOINT
-        if moved or gripped or turned or t in must:
+        if facts_changed(facts[keep[-1]], facts[t]) or t in must:
             keep.append(t)
             idle = 0
         elif idle < IDLE_KEEP:
@@ -129,6 +123,7 @@ def make_attempts(
     index: int,
     frames: int,
     form: str = "rover",
+    marks: dict | None = None,
 ):
     """Yield measured tries at an episode until the caller stops (at most `MAX_TRIES`).
 
@@ -137,9 +132,15 @@ def make_attempts(
     ending decides most milestones ("contact, but not picked up") and costs a few dozen
     steps, while the prefix (expert path and recovered deviations) is simulated once.
     A prefix whose recovery would make an object jump is replanned at once.
+
+    Levels with a ``milestone_cut`` leave the expert inside the stretch of the demo
+    between its last component and its next one (`rover.sim.cuts`); ``marks`` caches
+    each demo's `ExpertMarks` across episodes (default: this process's cache per task,
+    keyed by the demo's index and a checksum of its states).
     """
     from dataclasses import replace
 
+    from rover.sim.cuts import cut_window, draw_cut, progress_band
     from rover.sim.facts import detect_events, facts_for_states
     from rover.sim.perturb import (
         RandomSegment,
@@ -154,6 +155,7 @@ def make_attempts(
     signals = [s.end_signal for s in spec.subtasks]
     top = max(lv.level for lv in spec.levels)
     below = next((lv for lv in spec.levels if lv.level == level.level - 1), None)
+    marks = _MARKS.setdefault(spec.name, {}) if marks is None else marks
     tries = 0
     plan_no = 0
     while tries < MAX_TRIES:
@@ -164,14 +166,31 @@ def make_attempts(
         sim.reset(demo_seed)  # places robosuite's visual-only markers as in the demo's scene
         sim.begin(states[0])  # start positions (lift heights, goals) of this demo
         bounds = bounds_from_ends(ends, len(states))
-        plan = plan_trajectory(len(states), bounds, level, rng)
+        key = (d, len(states), zlib.crc32(np.ascontiguousarray(states).tobytes()))
+        if key not in marks:
+            marks[key] = demo_marks(sim, spec, states)
+        window = cut_window(level, spec.milestones, marks[key], frames)
+        cut = draw_cut(window, level, rng) if window is not None else None
+        plan = plan_trajectory(len(states), bounds, level, rng, cut=cut)
         act_rng = np.random.default_rng(rng.integers(2**63))
         terminal = plan.segments[-1] if plan.terminated else None
+        if terminal is not None:
+            drift = level.terminal_drift if any(level.terminal_drift) else None
+            terminal = replace(terminal, grip=_grip(level, actions, terminal.q), drift=drift)
         head = replace(plan, segments=plan.segments[:-1]) if terminal is not None else plan
         prefix = execute_plan(sim, states, actions, head, act_rng)
         if d not in expert_tracks:
             expert_tracks[d] = point_tracks(sim, states, names)
-        floor = _floor(below, expert_tracks[d], spec, bounds, int(ends[-1]), form)
+        pkey = ("progress", key, form)
+        if pkey not in marks:  # the expert's own progress per step
+            steps = np.arange(len(states))
+            marks[pkey] = progress_from_tracks(
+                expert_tracks[d], steps, expert_tracks[d], spec.subtasks, bounds,
+                goal_end=int(ends[-1]), form=form,  # type: ignore[arg-type]
+            )  # fmt: skip
+        band = progress_band(level, spec.milestones, marks[key], marks[pkey])
+        if band is None:  # no milestone marks: the level below's subtask fraction
+            band = (_floor(below, marks[pkey], bounds), 1.0)
         pre_tracks = point_tracks(sim, prefix.states, names, signals)
         endings = ENDINGS if terminal is not None else 1
         for e in range(endings):
@@ -181,7 +200,9 @@ def make_attempts(
                 seg = terminal
                 if e:  # a fresh ending, each a little gentler than the last
                     w = int(rng.integers(level.terminal_w[0], level.terminal_w[1] + 1))
-                    seg = RandomSegment(seg.q, w, seg.scale * 0.8**e, min(seg.hold, w), 0)
+                    seg = RandomSegment(
+                        seg.q, w, seg.scale * 0.8**e, min(seg.hold, w), 0, seg.grip, seg.drift
+                    )
                 tail_plan = TrajectoryPlan(
                     plan.expert_len, plan.subtask_bounds, (seg,), plan.level, True
                 )
@@ -198,6 +219,8 @@ def make_attempts(
                 form=form,  # type: ignore[arg-type]
             )
             pos = even_positions(len(roll), frames)
+            if terminal is not None:
+                pos = snap_position(pos, len(prefix) - 1)
             prev = roll.states[np.maximum(np.asarray(pos) - 1, 0)]
             facts = facts_for_states(sim, roll.states[pos], prev)
             events = detect_events(spec, facts)
@@ -209,10 +232,10 @@ def make_attempts(
                     f"a recovery leaves an object {roll.recovery_gap * 100:.1f} cm off the "
                     "expert state it hands over to (it would jump)"
                 )
-            if terminal is not None and prog[-1] < floor:
+            if terminal is not None and not band[0] <= prog[-1] <= band[1]:
                 problems.append(
-                    f"ends at progress {prog[-1]:.2f}, below where the level under it stops "
-                    f"({floor + FLOOR_TOLERANCE:.2f})"
+                    f"ends at progress {prog[-1]:.2f}, outside its level's band "
+                    f"{band[0]:.2f}..{band[1]:.2f} (`rover.sim.cuts.progress_band`)"
                 )
             if level.level == top and prog[-1] < HIGHEST_MIN_END:
                 problems.append(f"top level ends at progress {prog[-1]:.2f} < {HIGHEST_MIN_END}")
@@ -221,19 +244,53 @@ def make_attempts(
                 break  # the prefix itself is at fault: plan again
 
 
-def _floor(below, expert, spec: TaskSpec, bounds, goal_end: int, form: str) -> float:
-    """The expert's progress where the level below stops (its cut point's middle), less
-    `FLOOR_TOLERANCE`: a level's video must end at least that far along, so the final
-    progress rises with the level (0 when there is no terminating level below)."""
-    from rover.sim.value import progress_from_tracks
+def snap_position(pos: list[int], step: int) -> list[int]:
+    """Move the sampled position nearest to `step` onto it (first and last stay).
 
+    The step where a video leaves the expert is what its level shows (the fingers on
+    the can, the can just lifted): even sampling may fall either side of it, so the
+    nearest frame moves there, at most half a frame interval off even spacing.
+    """
+    if step in pos or len(pos) < 3:
+        return pos
+    k = min(range(1, len(pos) - 1), key=lambda i: abs(pos[i] - step))
+    if pos[k - 1] < step < pos[k + 1]:
+        pos = list(pos)
+        pos[k] = step
+    return pos
+
+
+def _grip(level: LevelSpec, actions: np.ndarray, q: int) -> float | None:
+    """The gripper command of a level's final deviation (None: random)."""
+    if level.terminal_grip == "open":
+        return -1.0
+    if level.terminal_grip == "close":
+        return 1.0
+    if level.terminal_grip == "keep" and len(actions):
+        return float(actions[min(int(q), len(actions) - 1)][-1])
+    return None
+
+
+def demo_marks(sim, spec: TaskSpec, states: np.ndarray):
+    """`ExpertMarks` of one expert demo, from the facts of every step (the simulator must
+    be reset to the demo's scene; no rendering). Each step's "moves with the hand" is
+    judged against the step before, as in a video's facts."""
+    from rover.sim.cuts import expert_marks
+    from rover.sim.facts import facts_for_states
+
+    saved = sim.get_state()
+    prev = states[np.maximum(np.arange(len(states)) - 1, 0)]
+    facts = facts_for_states(sim, states, prev)
+    sim.set_state(saved)
+    return expert_marks(spec, facts)
+
+
+def _floor(below, expert_progress: np.ndarray, bounds) -> float:
+    """Without milestone marks: the expert's progress in the middle of the level below's
+    subtask fraction, less `FLOOR_TOLERANCE` (0 with no terminating level below)."""
     if below is None or below.terminate_subtask is None:
         return 0.0
     k = min(below.terminate_subtask, len(bounds) - 1)
     a, b = bounds[k]
     cut = a + int(round(sum(below.terminate_at) / 2 * (b - a)))
-    steps = np.arange(len(expert))
-    prog = progress_from_tracks(
-        expert, steps, expert, spec.subtasks, bounds, goal_end=goal_end, form=form
-    )
-    return max(float(prog[cut]) - FLOOR_TOLERANCE, 0.0)
+    return max(float(expert_progress[cut]) - FLOOR_TOLERANCE, 0.0)

@@ -79,6 +79,25 @@ def untouched_rises(facts: list[FrameFacts]) -> list[str]:
     return out
 
 
+def facts_changed(a: FrameFacts, b: FrameFacts) -> bool:
+    """Whether anything visible changes from frame `a` to frame `b`: the hand or an
+    object moves more than `STILL_POS`, the gripper opens or closes more than
+    `STILL_GRIP`, or a joint turns more than `STILL_GRIP` of its range. The expert trim
+    (`rover.sim.attempt.trim_demo`) keeps steps by this same test."""
+    if a.eef is not None and b.eef is not None:
+        if max(abs(x - y) for x, y in zip(a.eef, b.eef, strict=True)) > STILL_POS:
+            return True
+    if a.gripper_opening is not None and b.gripper_opening is not None:
+        if abs(a.gripper_opening - b.gripper_opening) > STILL_GRIP:
+            return True
+    for name, ob in b.objects.items():
+        oa = a.objects.get(name)
+        if oa is not None and oa.position and ob.position:
+            if max(abs(x - y) for x, y in zip(oa.position, ob.position, strict=True)) > STILL_POS:
+                return True
+    return any(abs(v - a.articulations.get(k, v)) > STILL_GRIP for k, v in b.articulations.items())
+
+
 def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
     """Articulated parts that go from their start to their goal while progress gains less
     than `JOINT_GAIN`: progress must follow the joint (a knob's turn, a door's swing), not
@@ -110,20 +129,7 @@ def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
 
 
 def _changed(a: FrameFacts, b: FrameFacts, pa: float, pb: float) -> bool:
-    if abs(pb - pa) >= STILL_PROGRESS:
-        return True
-    if a.eef is not None and b.eef is not None:
-        if max(abs(x - y) for x, y in zip(a.eef, b.eef, strict=True)) > STILL_POS:
-            return True
-    if a.gripper_opening is not None and b.gripper_opening is not None:
-        if abs(a.gripper_opening - b.gripper_opening) > STILL_GRIP:
-            return True
-    for name, ob in b.objects.items():
-        oa = a.objects.get(name)
-        if oa is not None and oa.position and ob.position:
-            if max(abs(x - y) for x, y in zip(oa.position, ob.position, strict=True)) > STILL_POS:
-                return True
-    return any(abs(v - a.articulations.get(k, v)) > STILL_GRIP for k, v in b.articulations.items())
+    return abs(pb - pa) >= STILL_PROGRESS or facts_changed(a, b)
 
 
 def expert_stalls(episode: Episode) -> list[str]:

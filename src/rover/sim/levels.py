@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import zlib
 from collections.abc import Sequence
+from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, Field, model_validator
 
 IntRange = tuple[int, int]
 FloatRange = tuple[float, float]
+Grip = Literal["random", "keep", "open", "close"]
 
 
 class LevelSpec(BaseModel):
@@ -43,6 +45,18 @@ class LevelSpec(BaseModel):
         h: recovery horizon: the recovery heads for expert state ``q + h``.
         n_interp: interpolation steps of a recovery (smoothness).
         nested_prob: probability that a recovery is interrupted by a nested deviation.
+        milestone_cut: where the video leaves the expert, as a fraction of the stretch of
+            the expert's own demo between achieving this level's last component and
+            achieving its next one (`rover.sim.cuts`); None, or a demo in which the
+            expert never shows those components, falls back to ``terminate_subtask``
+            and ``terminate_at``.
+        terminal_grip: the gripper channel during the final deviation: "random" (the
+            paper: uniform like every other channel), "keep" (the expert's command at
+            the cut), "open" or "close" (forced, e.g. to let go of what was picked up,
+            or to keep holding what is carried).
+        terminal_drift: added to the final deviation's x, y, z action channels (then
+            clipped): (0, 0, -0.5) sets a just-lifted object back down as the fingers
+            open instead of dropping it; (0, 0, 0.3) backs the open hand off upwards.
     """
 
     level: int = Field(ge=1)
@@ -57,6 +71,9 @@ class LevelSpec(BaseModel):
     h: IntRange = (5, 25)
     n_interp: IntRange = (5, 15)
     nested_prob: float = Field(default=0.0, ge=0.0, le=1.0)
+    milestone_cut: FloatRange | None = None
+    terminal_grip: Grip = "random"
+    terminal_drift: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @model_validator(mode="after")
     def _ranges_ordered(self) -> LevelSpec:
@@ -70,6 +87,10 @@ class LevelSpec(BaseModel):
                 raise ValueError(f"level {self.level}: {field} must be 1 <= low <= high")
         if self.terminate_at[1] > 1.0:
             raise ValueError(f"level {self.level}: terminate_at must lie in [0, 1]")
+        if self.milestone_cut is not None:
+            lo, hi = self.milestone_cut
+            if not 0.0 <= lo <= hi <= 1.0:
+                raise ValueError(f"level {self.level}: milestone_cut must be 0 <= low <= high <= 1")
         if self.w[0] < 1 or self.terminal_w[0] < 1 or self.hold[0] < 1:
             raise ValueError(f"level {self.level}: w, terminal_w and hold must be >= 1")
         return self
@@ -142,6 +163,101 @@ def default_levels(milestones: Sequence[Sequence[str]]) -> list[LevelSpec]:
                 )
             )
     return levels
+
+
+# How a level that stops before component ``<kind>:<object>`` ends, by that kind: where in
+# the stretch between the expert achieving the level's last component and achieving that
+# one the video leaves the expert (`rover.sim.cuts.cut_window` says what the stretch is),
+# what the gripper does in the final deviation, and how long and wild that deviation is.
+# The paper's ending is uniform over every channel; these endings are bounded so that the
+# deviation neither completes the next component nor undoes the achieved ones.
+_PRE_GRASP = {"milestone_cut": (0.4, 0.9), "terminal_grip": "open", "terminal_w": (15, 35),
+              "scale": (0.4, 0.8)}  # fmt: skip
+ENDINGS_BY_KIND: dict[str, dict] = {
+    # fail to approach: leave early, anything goes (as the paper)
+    "approach": {"milestone_cut": (0.0, 0.2), "terminal_grip": "random"},
+    # approached, not touched: fingers open, move a little
+    "contact": {
+        "milestone_cut": (0.1, 0.5),
+        "terminal_grip": "open",
+        "terminal_w": (10, 25),
+        "scale": (0.2, 0.5),
+    },  # fmt: skip
+    # touched, not held: leave before the fingers close, keep them open, move away
+    "pick_up": _PRE_GRASP,
+    "grasp": _PRE_GRASP,
+    # any "<verb>_start": before the hand takes the handle or knob; back off upwards, as
+    # open fingers wandering at a handle push the door or drawer
+    "start": {
+        "milestone_cut": (0.4, 0.9),
+        "terminal_grip": "open",
+        "terminal_w": (10, 25),
+        "scale": (0.2, 0.4),
+        "terminal_drift": (0.0, 0.0, 0.3),
+    },  # fmt: skip
+    "press": {
+        "milestone_cut": (0.2, 0.7),
+        "terminal_grip": "open",
+        "terminal_w": (8, 20),
+        "scale": (0.15, 0.4),
+    },  # fmt: skip
+    # picked up, grasp not kept: let go within a frame of the lift, lowering the hand so
+    # the object is set back down (a drop from the lift topples tall items and rolls cans)
+    "carry": {
+        "milestone_cut": (0.0, 0.5),
+        "terminal_grip": "open",
+        "terminal_w": (8, 16),
+        "scale": (0.0, 0.1),
+        "terminal_drift": (0.0, 0.0, -0.5),
+    },  # fmt: skip
+    # carried, not over the target yet / over it, not released: keep holding, move little
+    "approach_goal": {
+        "milestone_cut": (0.0, 0.4),
+        "terminal_grip": "close",
+        "terminal_w": (8, 20),
+        "scale": (0.05, 0.2),
+        "terminal_drift": (0.0, 0.0, 0.3),
+    },  # fmt: skip
+    "place": {
+        "milestone_cut": (0.1, 0.6),
+        "terminal_grip": "close",
+        "terminal_w": (8, 20),
+        "scale": (0.1, 0.25),
+    },  # fmt: skip
+    # started, not finished: keep the handle (letting go undoes the grasp), move little
+    "finish": {
+        "milestone_cut": (0.1, 0.5),
+        "terminal_grip": "close",
+        "terminal_w": (8, 20),
+        "scale": (0.1, 0.3),
+    },  # fmt: skip
+}
+_DEFAULT_ENDING = {"milestone_cut": (0.2, 0.7), "terminal_grip": "keep", "terminal_w": (10, 25),
+                   "scale": (0.2, 0.5)}  # fmt: skip
+
+
+def component_kind(component: str) -> str:
+    """The ending family of a milestone component: ``"open_start:drawer"`` -> "start"."""
+    kind = component.partition(":")[0]
+    for suffix in ("_start", "_finish"):
+        if kind.endswith(suffix):
+            return suffix[1:]
+    return kind
+
+
+def by_milestone(levels: Sequence[LevelSpec], components: Sequence[str]) -> list[LevelSpec]:
+    """Levels cut by milestone: level L leaves the expert between the demo's achievement
+    of component L-1 and of component L, with the ending `ENDINGS_BY_KIND` gives
+    component L's kind. The subtask-fraction knobs stay as the fallback, so a level
+    still plans without a demo's milestone steps."""
+    out = []
+    for lv in levels:
+        if lv.completes or lv.level - 1 >= len(components):
+            out.append(lv)
+            continue
+        knobs = ENDINGS_BY_KIND.get(component_kind(components[lv.level - 1]), _DEFAULT_ENDING)
+        out.append(lv.model_copy(update=dict(knobs)))
+    return out
 
 
 def plan_seed(seed: int, task: str, index: int) -> np.random.Generator:

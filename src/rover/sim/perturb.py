@@ -56,6 +56,8 @@ class RandomSegment:
     scale: float = 1.0
     hold: int = 1
     depth: int = 0
+    grip: float | None = None  # gripper command held throughout (None: random like the rest)
+    drift: tuple[float, float, float] | None = None  # added to the x, y, z channels
 
 
 @dataclass(frozen=True)
@@ -164,7 +166,11 @@ def _drawf(rng: np.random.Generator, r: tuple[float, float]) -> float:
 
 
 def plan_trajectory(
-    expert_len: int, subtask_bounds: Bounds, level: LevelSpec, rng: np.random.Generator
+    expert_len: int,
+    subtask_bounds: Bounds,
+    level: LevelSpec,
+    rng: np.random.Generator,
+    cut: int | None = None,
 ) -> TrajectoryPlan:
     """Plan one non-expert trajectory of the given level; pure and deterministic for ``rng``.
 
@@ -180,10 +186,14 @@ def plan_trajectory(
         subtask_bounds: inclusive (start, end) expert indices of each subtask, tiling 0..T-1.
         level: the level's knobs.
         rng: the video's Generator (see `rover.sim.levels.plan_seed`).
+        cut: expert step at which a terminating level leaves the expert for good (from
+            `rover.sim.cuts`); None draws it from ``terminate_subtask``/``terminate_at``.
     """
     bounds = check_bounds(expert_len, subtask_bounds)
     last = expert_len - 1
-    if level.terminate_subtask is not None:
+    if level.terminate_subtask is not None and cut is not None:
+        q_end = min(max(int(cut), 0), last)
+    elif level.terminate_subtask is not None:
         k = min(max(level.terminate_subtask, 0), len(bounds) - 1)
         a, b = bounds[k]
         q_end = a + int(round(_drawf(rng, level.terminate_at) * (b - a)))
@@ -318,6 +328,10 @@ def execute_plan(
             for i in range(seg.w):
                 if action is None or i % seg.hold == 0:
                     action = random_action(rng, adapter.action_low, adapter.action_high, seg.scale)
+                    if seg.grip is not None:  # the last channel is the gripper's
+                        action[-1] = seg.grip
+                    if seg.drift is not None:  # the first three move the hand
+                        action[:3] = np.clip(action[:3] + np.asarray(seg.drift), -1.0, 1.0)
                 adapter.step(action)
                 j_total += 1
                 record(adapter.get_state(), seg.q, j_total, 0, seg.depth, StateType.non_expert)

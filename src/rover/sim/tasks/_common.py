@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from rover.sim.levels import LevelSpec, default_levels
+from rover.sim.levels import LevelSpec, by_milestone, default_levels
 from rover.sim.tasks.base import QATemplate, SubtaskSpec
 
 FINGERS = ["left_finger", "right_finger"]
@@ -53,8 +53,8 @@ def contact_before_grasp(levels: list[LevelSpec], level: int = 3) -> list[LevelS
 
 
 def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
-    """App. B Table 5, pick-and-place group: seven levels."""
-    return named_levels(
+    """App. B Table 5, pick-and-place group: seven levels, cut by milestone."""
+    levels = named_levels(
         [
             [f"Approach the {obj}", f"Contact the {obj}"],
             [f"Keep grasp of the {obj}", f"Approach placing the {obj} {target}"],
@@ -69,6 +69,7 @@ def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
             f"Place the {obj} {target}",
         ],
     )
+    return by_milestone(levels, pick_place_milestones(obj))
 
 
 def pick_place_milestones(obj: str) -> list[str]:

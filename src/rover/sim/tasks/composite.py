@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rover.sim.levels import default_levels
+from rover.sim.levels import by_milestone, default_levels
 from rover.sim.tasks._common import grasp_subtask, move_subtask, pick_place_qa
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
 from rover.sim.tasks.pick_place import BIN_OF, BODY_OF, bin_name
@@ -24,6 +24,7 @@ def restock_task(items: tuple[str, ...] = ITEMS) -> TaskSpec:
     for obj in items:
         names += [f"Pick up the {obj}", f"Place the {obj} in {bin_name(obj)}"]
     levels = [lv.model_copy(update={"name": n}) for lv, n in zip(levels, names, strict=True)]
+    milestones = [f"{k}:{o}" for o in items for k in ("pick_up", "place")]
     listing = " and ".join(f"the {o} {'in ' + bin_name(o)}" for o in items)
     return TaskSpec(
         name="Restock",
@@ -38,8 +39,8 @@ def restock_task(items: tuple[str, ...] = ITEMS) -> TaskSpec:
         goals={f"bin_{o}": GoalSpec(kind="bin", object=o) for o in items},
         bins={o: BIN_OF[o] for o in items},
         subtasks=subtasks,
-        levels=levels,
-        milestones=[f"{k}:{o}" for o in items for k in ("pick_up", "place")],
+        levels=by_milestone(levels, milestones),
+        milestones=milestones,
         qa_templates=qa,
         frames=60,
         expert="pick_place",

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from rover.sim.levels import by_milestone
 from rover.sim.tasks._common import FINGERS, contact_before_grasp, named_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
+MILESTONES = ["approach:door", "contact:door", "open_start:door", "open_finish:door"]
 OPEN_ANGLE = 0.35  # rad of hinge travel counted as "completely open" (robosuite: > 0.3)
 
 DOOR = TaskSpec(
@@ -36,19 +38,22 @@ DOOR = TaskSpec(
             end_signal="opened:door",
         ),
     ],
-    levels=contact_before_grasp(
-        named_levels(
-            [["Approach the door"], ["Start opening the door"]],
-            [
-                "Fail to approach the door",
-                "Approach the door",
-                "Contact the door",
-                "Start opening the door",
-                "Finish opening the door",
-            ],
-        )
+    levels=by_milestone(
+        contact_before_grasp(
+            named_levels(
+                [["Approach the door"], ["Start opening the door"]],
+                [
+                    "Fail to approach the door",
+                    "Approach the door",
+                    "Contact the door",
+                    "Start opening the door",
+                    "Finish opening the door",
+                ],
+            )
+        ),
+        MILESTONES,
     ),
-    milestones=["approach:door", "contact:door", "open_start:door", "open_finish:door"],
+    milestones=MILESTONES,
     qa_templates=[
         QATemplate(
             id="did_contact",

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+from rover.sim.levels import by_milestone
 from rover.sim.tasks._common import grasp_subtask, move_subtask, named_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, TaskSpec
+
+MILESTONES = ["approach:cube", "contact:cube", "pick_up:cube"]
 
 LIFT = TaskSpec(
     name="Lift",
@@ -16,11 +19,19 @@ LIFT = TaskSpec(
         grasp_subtask("grasp the cube", "cube", signal="grasped:cube"),
         move_subtask("lift the cube", "cube", "goal:lift", "lifted:cube", beta=0.7),
     ],
-    levels=named_levels(
-        [["Approach the cube"], []],
-        ["Fail to approach the cube", "Approach the cube", "Contact the cube", "Pick up the cube"],
+    levels=by_milestone(
+        named_levels(
+            [["Approach the cube"], []],
+            [
+                "Fail to approach the cube",
+                "Approach the cube",
+                "Contact the cube",
+                "Pick up the cube",
+            ],
+        ),
+        MILESTONES,
     ),
-    milestones=["approach:cube", "contact:cube", "pick_up:cube"],
+    milestones=MILESTONES,
     qa_templates=[
         QATemplate(
             id="did_contact",

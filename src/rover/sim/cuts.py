@@ -1,0 +1,188 @@
+"""Where a level's video leaves the expert, read from the expert's own demo.
+
+A level of App. B Table 5 means "components 1..L-1 achieved, component L not". Cutting
+at a fixed fraction of a subtask's expert steps ignores when the expert actually
+achieves each component, so the random ending often completed the next one or had not
+reached the current one. Here the facts of every expert step are read once per demo (no
+rendering) and `ExpertMarks` records the first step at which each milestone component
+(`TaskSpec.milestones`) holds, plus when each hold begins and ends; `cut_window` turns
+a level into the stretch of expert steps where its video may stop following the expert:
+after component L-1, before component L (and, for the components an ending must not
+cause, before the hold or release that would cause it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rover.episode import FrameFacts
+from rover.sim.levels import LevelSpec, component_kind
+from rover.sim.milestones import achieved
+from rover.sim.tasks.base import TaskSpec
+
+CARRY_WINDOW_FRAMES = 1.0  # a "picked up, not carried" video lets go within a frame
+
+
+@dataclass(frozen=True)
+class ExpertMarks:
+    """Milestone steps of one (trimmed) expert demo.
+
+    Attributes:
+        steps: per component of the task, the first expert step at which the prefix of
+            the demo up to it shows the component (None: the expert never shows it).
+        holds: object -> (first held step, first step after the hold or None) per hold.
+        length: number of expert steps.
+    """
+
+    steps: tuple[int | None, ...]
+    holds: dict[str, tuple[tuple[int, int | None], ...]]
+    length: int
+
+
+def expert_marks(spec: TaskSpec, facts: Sequence[FrameFacts]) -> ExpertMarks:
+    """Find each component's first step by bisection over prefixes of the facts.
+
+    Every component kind is monotone in the prefix (once a prefix shows it, every
+    longer one does), so bisection finds the first step in log2(T) checks.
+    """
+    from rover.sim.facts import detect_events, hold_spans
+
+    facts = list(facts)
+    n = len(facts)
+
+    def shows(comp: str, t: int) -> bool:
+        head = facts[: t + 1]
+        return achieved(comp, head, detect_events(spec, head))
+
+    steps: list[int | None] = []
+    for comp in spec.milestones:
+        if not n or not shows(comp, n - 1):
+            steps.append(None)
+            continue
+        lo, hi = 0, n - 1
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if shows(comp, mid):
+                hi = mid
+            else:
+                lo = mid + 1
+        steps.append(lo)
+    holds = {o.name: tuple(hold_spans(facts, o.name)) for o in spec.objects}
+    return ExpertMarks(tuple(steps), holds, n)
+
+
+def _hold_after(marks: ExpertMarks, obj: str, t: int) -> tuple[int, int | None] | None:
+    for start, end in marks.holds.get(obj, ()):
+        if end is None or end > t:
+            return start, end
+    return None
+
+
+def cut_window(
+    level: LevelSpec,
+    components: Sequence[str],
+    marks: ExpertMarks,
+    frames: int,
+) -> tuple[int, int] | None:
+    """Inclusive expert steps ``(lo, hi)`` where a video of `level` may leave the expert.
+
+    From the step component L-1 is first shown (0 for level 1) to the step before
+    component L is: pre-grasp components end the stretch before the hand takes the
+    object; "place" ends it before the hold ends (the ending keeps holding); "carry" is
+    the `CARRY_WINDOW_FRAMES` video frames after the pick-up (the ending lets go, so the
+    video shows the object held off its start for fewer frames than "carry" needs).
+    None when the demo never shows a component the level needs, or the stretch is empty.
+    """
+    L = level.level
+    if level.completes or level.milestone_cut is None or L - 1 >= len(components):
+        return None
+    nxt = components[L - 1]
+    kind = component_kind(nxt)
+    obj = nxt.partition(":")[2]
+    lo = 0 if L == 1 else marks.steps[L - 2]
+    if lo is None:
+        return None
+    t_next = marks.steps[L - 1]
+    hi = (marks.length - 1) if t_next is None else t_next - 1
+    if kind in ("pick_up", "grasp", "start"):
+        hold = _hold_after(marks, obj, lo)
+        if hold is not None and hold[0] >= lo:  # (at the contact itself when both coincide)
+            hi = min(hi, max(hold[0] - 1, lo))
+    elif kind == "place":
+        hold = _hold_after(marks, obj, lo)
+        if hold is not None and hold[1] is not None:
+            hi = min(hi, hold[1] - 1)
+    elif kind == "carry":
+        # "carry" counts video frames, not expert steps: frames are spaced by (steps of
+        # the video) / (frames - 1), and the video runs to about the cut plus the ending
+        w = sum(level.terminal_w) / 2
+        span = CARRY_WINDOW_FRAMES / max(frames - 1, 1)
+        hi = min(marks.length - 1, int((lo + span * w) / max(1.0 - span, 0.1)))
+    if hi < lo:
+        return None
+    return int(lo), int(hi)
+
+
+def draw_cut(window: tuple[int, int], level: LevelSpec, rng: np.random.Generator) -> int:
+    """The expert step the video leaves at: ``level.milestone_cut`` of the window."""
+    lo, hi = window
+    a, b = level.milestone_cut or (0.0, 1.0)
+    f = float(rng.uniform(a, b)) if b > a else float(a)
+    return lo + int(round(f * (hi - lo)))
+
+
+BAND_UNDO = 0.1  # progress an ending may lose below the component the level achieved
+BAND_GAP = 0.02  # "moved off": a touched-not-held level ends this far below the contact
+
+
+def progress_band(
+    level: LevelSpec, components: Sequence[str], marks: ExpertMarks, expert: np.ndarray
+) -> tuple[float, float] | None:
+    """``(floor, ceiling)`` of a level's final progress, from the expert's progress at
+    its components (`expert`: progress per expert step), so the bands rise with the
+    level and so does the final progress (the audit's order check):
+
+    * in general the ending may undo at most `BAND_UNDO` of what the level achieved:
+      floor = progress at component L-1, less `BAND_UNDO`;
+    * "approached, not touched" ends below half way from the approach to the contact,
+      and "touched, not held" (the hand leaves before the grasp) between that and
+      `BAND_GAP` below the contact;
+    * "picked up, not carried" lets go, and the object lies where it was touched: at
+      least `BAND_GAP` below the contact.
+
+    None when the demo does not show the components the band reads.
+    """
+    L = level.level
+    if level.completes or L - 1 >= len(components):
+        return None
+    kind = component_kind(components[L - 1])
+    s = marks.steps
+
+    def at(i: int) -> float | None:  # progress at component i (0-based); -1: the start
+        if i < 0:
+            return 0.0
+        return None if s[i] is None else float(expert[s[i]])
+
+    if L == 1:
+        return 0.0, 1.0
+    here = at(L - 2)
+    if here is None:
+        return None
+    if kind == "contact":
+        nxt = at(L - 1)
+        return max(here - BAND_UNDO, 0.0), 1.0 if nxt is None else (here + nxt) / 2
+    if kind in ("pick_up", "grasp", "start"):
+        before = at(L - 3)
+        if before is None:
+            return None
+        # (an object let go after its pick-up lies where it was touched: this level must
+        # end below that; a handle let go is never part of a level, so no ceiling there)
+        top = max(here - BAND_GAP, 0.0) if kind != "start" else 1.0
+        return (before + here) / 2, top
+    if kind == "carry":
+        before = at(L - 3)
+        return (max(before - BAND_GAP, 0.0) if before is not None else 0.0), 1.0
+    return max(here - BAND_UNDO, 0.0), 1.0
