@@ -9,7 +9,10 @@ level, one video each, views wrist, left and right, 128 px, seed 0. Then, per ta
   start, middle and end frame of that video;
 - ``progress_<task>.png``: ground-truth progress of every video over normalised time,
   one colour per level, each frame's state type marked (expert, non-expert,
-  interpolating) so recoveries and final deviations show.
+  interpolating) so recoveries and final deviations show; the frames of the grasp (g),
+  drop (d) and place (p) events written on each curve; for an articulated task, the
+  top level's joint (fraction of the way to its goal) dashed, so progress can be
+  checked against the knob's turn or the drawer's slide.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from PIL import Image, ImageDraw
 from rover.episode import Episode, StateType
 from rover.io.dataset import load_dataset
 
+EVENT_MARK = {"grasp": "g", "drop": "d", "place": "p"}
 TYPE_MARK = {
     StateType.expert: ("o", "#4c72b0", "expert"),
     StateType.non_expert: ("x", "#c44e52", "non-expert"),
@@ -83,6 +87,22 @@ def progress_plot(task: str, episodes: list[Episode], path: Path) -> None:
             lab = None if name in seen else name
             seen.add(name)
             ax.scatter(x[idx], np.asarray(tr.progress)[idx], marker=mark, c=c, s=14, label=lab)
+        for ev in tr.events:
+            if ev.name in EVENT_MARK and ev.frame is not None:
+                t = ev.frame
+                ax.annotate(
+                    EVENT_MARK[ev.name],
+                    (x[t], tr.progress[t]),
+                    xytext=(0, 5),
+                    textcoords="offset points",
+                    fontsize=7,
+                    color=colour,
+                    ha="center",
+                )
+    top = max(episodes, key=lambda e: (e.truth.level or 0, e.id))
+    for name, way in _joint_ways(top).items():
+        x = np.linspace(0, 1, top.num_frames)
+        ax.plot(x, way, color="0.35", lw=1.0, ls="--", label=f"{name} (L{top.truth.level})")
     handles, labels = ax.get_legend_handles_labels()
     uniq = dict(zip(labels, handles, strict=False))
     ax.legend(uniq.values(), uniq.keys(), fontsize=7, ncol=2, loc="upper left")
@@ -90,6 +110,19 @@ def progress_plot(task: str, episodes: list[Episode], path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def _joint_ways(ep: Episode) -> dict[str, list[float]]:
+    """Each articulated part's fraction of the way to its goal per frame (a part starting
+    past half way, an open drawer to close, counts down from 1)."""
+    facts = ep.truth.facts if ep.truth else None
+    if not facts or not facts[0].articulations:
+        return {}
+    out = {}
+    for name, first in facts[0].articulations.items():
+        vals = [f.articulations.get(name, first) for f in facts]
+        out[name] = [1.0 - v if first > 0.5 else v for v in vals]
+    return out
 
 
 def main() -> None:
