@@ -62,6 +62,11 @@ class BaseBackend:
         """The kind of failure `exc` is; None lets it propagate (not an API error)."""
         return None
 
+    def _prepare(self) -> None:
+        """Set up what calls in this event loop share (HTTP clients), before the first
+        timed attempt: building a client and the SDK's lazy imports take seconds on a busy
+        CPU and must not eat into a call's timeout."""
+
     def cache_extra(self) -> dict[str, Any]:
         """Backend settings that change answers and so belong in the cache key."""
         return {}
@@ -111,6 +116,7 @@ class BaseBackend:
             if hit is not None:
                 return hit
         async with self._semaphore():
+            self._prepare()
             start = time.perf_counter()
             raw = await call_with_retries(
                 lambda: self._generate(prompt, params),

@@ -68,6 +68,9 @@ class GeminiBackend(BaseBackend):
     def endpoint(self) -> str:
         return endpoint_identity(self.base_url or DEFAULT_BASE_URL)
 
+    def _prepare(self) -> None:
+        _ = self._client().aio.models  # this loop's client, before the first timed attempt
+
     def _client(self) -> Any:
         def make() -> Any:
             genai = _import_genai()

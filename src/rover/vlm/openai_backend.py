@@ -133,6 +133,12 @@ class OpenAIBackend(BaseBackend):
         # the pool times each replica's attempt itself, so a failover gets a fresh timeout
         return dataclasses.replace(policy, wrap_timeout=False)
 
+    def _prepare(self) -> None:
+        # every replica's client for this loop, its chat resource imported (lazily, by the SDK)
+        urls = [r.url for r in self.pool.replicas] if self.pool is not None else [self.base_url]
+        for url in urls:
+            _ = self._client(url).chat.completions
+
     def _client(self, base_url: str | None = None) -> Any:
         url = base_url or self.base_url
 
