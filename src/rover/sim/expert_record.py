@@ -4,8 +4,11 @@
 the benchmark writes each task's result (successes, seeds, mean steps, date) into
 ``expert_success.json`` beside this module, and readers only ever show what is recorded
 there ("not measured" otherwise). Each record carries a fingerprint of what the expert
-ran against (the task spec and, for a kitchen task, its fixture's MJCF), so a record
-made before the task changed is reported as stale rather than passed off as current.
+ran against (the spec fields its run depends on and, for a kitchen task, its fixture's
+MJCF), so a record made before those changed is reported as stale rather than passed
+off as current; a change of levels or questions leaves it standing. Changes to the
+expert scripts themselves are not fingerprinted: rerun the benchmark with --write after
+changing one.
 """
 
 from __future__ import annotations
@@ -27,9 +30,25 @@ ABOUT = (
 )
 
 
+# the spec fields a scripted expert's run depends on (its scene, script, step budget and
+# success test); levels, questions and wordings do not change whether it succeeds
+EXPERT_FIELDS = {
+    "env_name",
+    "env_kwargs",
+    "objects",
+    "goals",
+    "subtasks",
+    "expert",
+    "max_expert_steps",
+    "bins",
+    "clear_objects",
+}
+
+
 def fingerprint(spec: TaskSpec) -> str:
-    """12 hex digits over the task spec and, for a kitchen task, its fixture's MJCF."""
-    h = hashlib.sha256(spec.model_dump_json().encode())
+    """12 hex digits over what the expert ran against: the spec fields it depends on
+    (`EXPERT_FIELDS`) and, for a kitchen task, its fixture's MJCF."""
+    h = hashlib.sha256(json.dumps(spec.model_dump(include=EXPERT_FIELDS), sort_keys=True).encode())
     fixture = spec.env_kwargs.get("fixture") if spec.suite == "kitchen" else None
     if fixture:
         from rover.sim.kitchen.fixtures import FIXTURES

@@ -15,6 +15,7 @@ import numpy as np
 
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
+from rover.sim.levels import by_milestone
 from rover.sim.tasks._common import FINGERS, named_levels
 from rover.sim.tasks.articulated import drawer_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
@@ -370,4 +371,7 @@ TASKS: list[TaskSpec] = [
         obj="sink spout",
     ),
 ]
+# levels leave the expert by milestone, as the tabletop tasks' do (each level between
+# its demo's achievement of component L-1 and L, with the ending component L's kind gets)
+TASKS = [t.model_copy(update={"levels": by_milestone(t.levels, t.milestones)}) for t in TASKS]
 TASKS += PICK_PLACE_TASKS  # the pick-and-place group (rover.sim.kitchen.pick_place)
