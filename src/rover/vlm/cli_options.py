@@ -47,8 +47,7 @@ from rover.errors import InputError
 from rover.vlm.config import BackendConfig
 
 VLM_HELP = (
-    "VLM spec: openai:<model>[@<url>[,<url>...]], gemini:<model>, hf:<path>, "
-    "oracle, replay:<file>"
+    "VLM spec: openai:<model>[@<url>[,<url>...]], gemini:<model>, hf:<path>, oracle, replay:<file>"
 )
 
 VLMOpt = Annotated[str, typer.Option("--vlm", help=VLM_HELP)]
