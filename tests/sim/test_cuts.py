@@ -202,3 +202,12 @@ def test_progress_bands_rise_with_the_level():
         assert bands[lo_lv][1] <= bands[hi_lv][0] + 1e-9
     gone = ExpertMarks(steps=(10, None, None, None, None, None), holds={}, length=90)
     assert progress_band(spec.levels[2], COMPS, gone, expert) is None
+
+
+def test_window_starts_once_every_earlier_component_is_shown():
+    # a Stack-like demo grasps the cube already over its target (approach_goal at 26,
+    # before carry at 36): "approach placing" starts at 36, "carry" has no stretch
+    m = ExpertMarks(steps=(11, 26, 33, 36, 26, 81), holds={"can": ((26, 80),)}, length=90)
+    levels = {lv.level: lv for lv in get_task("PickPlaceCan").levels}
+    assert cut_window(levels[6], COMPS, m, 30) == (36, 79)
+    assert cut_window(levels[5], COMPS, m, 30) is None

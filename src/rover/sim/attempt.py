@@ -161,17 +161,18 @@ def make_attempts(
     while tries < MAX_TRIES:
         rng = plan_seed(seed, spec.name, index + plan_no * TRY_STRIDE)
         plan_no += 1
-        d = int(rng.integers(len(demos)))
+        usable = _usable_demos(sim, spec, level, demos, marks, frames)
+        d = int(usable[int(rng.integers(len(usable)))])
         states, actions, ends, demo_seed = demos[d]
         sim.reset(demo_seed)  # places robosuite's visual-only markers as in the demo's scene
         sim.begin(states[0])  # start positions (lift heights, goals) of this demo
         bounds = bounds_from_ends(ends, len(states))
-        key = (d, len(states), zlib.crc32(np.ascontiguousarray(states).tobytes()))
-        if key not in marks:
-            marks[key] = demo_marks(sim, spec, states)
+        key = _demo_key(d, states)
         window = cut_window(level, spec.milestones, marks[key], frames)
         cut = draw_cut(window, level, rng) if window is not None else None
-        plan = plan_trajectory(len(states), bounds, level, rng, cut=cut)
+        plan = plan_trajectory(
+            len(states), bounds, level, rng, cut=cut, deviate_before=window and window[0]
+        )
         act_rng = np.random.default_rng(rng.integers(2**63))
         terminal = plan.segments[-1] if plan.terminated else None
         if terminal is not None:
@@ -242,6 +243,29 @@ def make_attempts(
             yield Attempt(tries, d, roll, prog, pos, facts, events, problems)
             if roll.recovery_gap > RECOVERY_GAP or tries >= MAX_TRIES:
                 break  # the prefix itself is at fault: plan again
+
+
+def _demo_key(d: int, states: np.ndarray) -> tuple[int, int, int]:
+    return (d, len(states), zlib.crc32(np.ascontiguousarray(states).tobytes()))
+
+
+def _usable_demos(sim, spec: TaskSpec, level: LevelSpec, demos: list, marks: dict, frames: int):
+    """The demos in which a level can be cut by milestone (all of them when none can, or
+    the level does not cut by milestone): a Stack demo that grasps the red cube already
+    within reach of the green one shows "over the target" before "carry", so its L5
+    stretch is empty."""
+    from rover.sim.cuts import cut_window
+
+    ok = []
+    for d, (states, _, _, demo_seed) in enumerate(demos):
+        key = _demo_key(d, states)
+        if key not in marks:
+            sim.reset(demo_seed)
+            sim.begin(states[0])
+            marks[key] = demo_marks(sim, spec, states)
+        if level.milestone_cut is None or cut_window(level, spec.milestones, marks[key], frames):
+            ok.append(d)
+    return ok or list(range(len(demos)))
 
 
 def snap_position(pos: list[int], step: int) -> list[int]:

@@ -74,6 +74,17 @@ def expert_marks(spec: TaskSpec, facts: Sequence[FrameFacts]) -> ExpertMarks:
     return ExpertMarks(tuple(steps), holds, n)
 
 
+def _all_shown(marks: ExpertMarks, k: int) -> int | None:
+    """The first step by which the expert has shown components 1..k (0 for none; None
+    if it never shows one). Usually component k's step, but not always: a Stack demo
+    may grasp the red cube already within reach of the green one ("over the target"
+    before "carry")."""
+    got = marks.steps[:k]
+    if any(s is None for s in got):
+        return None
+    return max(got, default=0)
+
+
 def _hold_after(marks: ExpertMarks, obj: str, t: int) -> tuple[int, int | None] | None:
     for start, end in marks.holds.get(obj, ()):
         if end is None or end > t:
@@ -102,7 +113,7 @@ def cut_window(
     nxt = components[L - 1]
     kind = component_kind(nxt)
     obj = nxt.partition(":")[2]
-    lo = 0 if L == 1 else marks.steps[L - 2]
+    lo = _all_shown(marks, L - 1)
     if lo is None:
         return None
     t_next = marks.steps[L - 1]
@@ -168,9 +179,10 @@ def progress_band(
 
     if L == 1:
         return 0.0, 1.0
-    here = at(L - 2)
-    if here is None:
+    shown = _all_shown(marks, L - 1)
+    if shown is None:
         return None
+    here = float(expert[shown])
     if kind == "contact":
         nxt = at(L - 1)
         return max(here - BAND_UNDO, 0.0), 1.0 if nxt is None else (here + nxt) / 2

@@ -171,6 +171,7 @@ def plan_trajectory(
     level: LevelSpec,
     rng: np.random.Generator,
     cut: int | None = None,
+    deviate_before: int | None = None,
 ) -> TrajectoryPlan:
     """Plan one non-expert trajectory of the given level; pure and deterministic for ``rng``.
 
@@ -188,6 +189,10 @@ def plan_trajectory(
         rng: the video's Generator (see `rover.sim.levels.plan_seed`).
         cut: expert step at which a terminating level leaves the expert for good (from
             `rover.sim.cuts`); None draws it from ``terminate_subtask``/``terminate_at``.
+        deviate_before: recovered deviations branch before this expert step (None: any
+            step before the cut). A level's window starts where its last component is
+            achieved; random actions after that, next to the object, can achieve the
+            next one (push the door ajar) before the video even leaves the expert.
     """
     bounds = check_bounds(expert_len, subtask_bounds)
     last = expert_len - 1
@@ -201,7 +206,7 @@ def plan_trajectory(
         q_end = last
     n_dev = _draw(rng, level.deviations)
     # branch points leave room for the recovery horizon before the end point
-    room = q_end - 1
+    room = q_end - 1 if deviate_before is None else min(q_end, int(deviate_before)) - 1
     qs = sorted(rng.choice(room, size=min(n_dev, room), replace=False).tolist()) if room > 0 else []
 
     segments: list[Segment] = []
