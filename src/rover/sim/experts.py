@@ -35,6 +35,15 @@ POS_SCALE = 0.05  # m per unit action (robosuite OSC_POSE output_max)
 ROT_SCALE = 0.5  # rad per unit action
 ROT_TOL = 0.08  # rad: a waypoint counts as reached only once the hand is turned too
 MAX_WRIST_YAW = 1.6  # rad from the start pose the scripts may turn the hand about z
+# a waypoint phase also ends once the hand is stuck near its target: over the last
+# STUCK_STEPS steps the error shrank less than STUCK_GAIN while within STUCK_REACH
+# tolerances of it. At the edge of the workspace (the far PickPlace bin) the controller
+# settles 2-5 cm short and the phase would otherwise burn its whole step budget with
+# the hand still (a visible stall of up to 170 steps); the next phase starts from there.
+STUCK_STEPS = 10
+STUCK_GAIN = 0.002  # m ...
+STUCK_TURN = 0.02  # ... and the turn to the wanted orientation less than this (rad)
+STUCK_REACH = 3.0
 
 
 @dataclass
@@ -73,19 +82,26 @@ class Scripted:
     def run(self, phase: Phase) -> None:
         yaw = self.yaw0 if phase.yaw is None else phase.yaw()
         self.yaw0 = yaw
+        errs: list[tuple[float, float]] = []  # (position error m, orientation error rad)
         for k in range(phase.steps):
             if phase.done is not None and phase.done():
                 return
             if phase.track_yaw and phase.yaw is not None:
                 yaw = phase.yaw()
             target = phase.target()
-            if (
-                phase.tol is not None
-                and k >= phase.min_steps
-                and np.linalg.norm(target - self.sim.point("eef")) < phase.tol
-                and np.linalg.norm(self.rot_error(yaw)) < ROT_TOL
-            ):
-                return
+            if phase.tol is not None and k >= phase.min_steps:
+                err = float(np.linalg.norm(target - self.sim.point("eef")))
+                turn = float(np.linalg.norm(self.rot_error(yaw)))
+                errs.append((err, turn))
+                if err < phase.tol and turn < ROT_TOL:
+                    return
+                if (
+                    len(errs) > STUCK_STEPS
+                    and err < STUCK_REACH * phase.tol
+                    and errs[-1 - STUCK_STEPS][0] - err < STUCK_GAIN
+                    and errs[-1 - STUCK_STEPS][1] - turn < STUCK_TURN
+                ):
+                    return
             act = self.action(target, phase.grip, yaw, phase.gain)
             self.states.append(self.sim.get_state())
             self.actions.append(act)

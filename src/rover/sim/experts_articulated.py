@@ -18,6 +18,10 @@ from rover.sim.motions import CLOSE, OPEN, Phase
 LEAD = 0.04  # m (drawer) the pull/push target runs ahead of the handle
 TURN_LEAD = 0.35  # rad the hand's yaw runs ahead of the knob while turning
 KNOB_DZ = 0.022  # m above the knob's centre the fingers grip it
+# m the hand comes down outside the drawer's bar handle (away from the drawer front):
+# centred on the bar, the inner finger of the open hand lands on the front's top edge
+# and shoves the drawer before the grasp (open by a third, then pushed back)
+HANDLE_OUT = 0.008
 
 
 def latch(sim: SimEnv) -> Callable[[], np.ndarray]:
@@ -39,6 +43,12 @@ def _drawer(sim: SimEnv, closing: bool) -> list[Phase]:
     def handle() -> np.ndarray:
         return sim.point("drawer:handle")
 
+    def outside() -> np.ndarray:  # the descent point, a little out from the bar
+        q = fx.joint_value()
+        out = fx.site_at("handle", q + 0.01) - fx.site_at("handle", q)
+        out[2] = 0.0
+        return handle() + HANDLE_OUT * out / max(float(np.linalg.norm(out)), 1e-9)
+
     def move() -> np.ndarray:
         step = -LEAD if closing else LEAD
         return fx.site_at("handle", fx.joint_value() + step)
@@ -46,9 +56,9 @@ def _drawer(sim: SimEnv, closing: bool) -> list[Phase]:
     hold, rest = latch(sim), latch(sim)
     return [
         Phase(
-            lambda: handle() + np.array([0, 0, 0.08]), OPEN, tol=0.012, steps=80, yaw=lambda: yaw
+            lambda: outside() + np.array([0, 0, 0.08]), OPEN, tol=0.012, steps=80, yaw=lambda: yaw
         ),
-        Phase(handle, OPEN, tol=0.006, steps=40, gain=1.5),
+        Phase(outside, OPEN, tol=0.006, steps=40, gain=1.5),
         Phase(hold, CLOSE, tol=None, steps=10),
         Phase(move, CLOSE, tol=None, steps=120, gain=0.8, done=lambda: fx.progress() >= 0.97),
         Phase(rest, OPEN, tol=None, steps=8),

@@ -70,20 +70,31 @@ def grasp_yaw(
     return wrap_angle(yaw_of(mat) + offset, period)
 
 
+CLEAR_GAP = 0.06  # m: fingers this far from every other object are clear of them
+
+
 def clear_yaw(sim: SimEnv, obj: str) -> float:
-    """For a round object: the yaw whose fingers land farthest from other objects."""
+    """For a round object: the yaw nearest the start pose (0) whose fingers land at least
+    `CLEAR_GAP` from other objects, else the one whose fingers land farthest from them.
+
+    Staying near 0 leaves the wrist room to turn on the way to a far goal: a can picked
+    at a quarter turn reaches the far PickPlace bin with its last joint at its limit.
+    """
     centre = sim.point(obj)[:2]
     others = [sim.point(o.name)[:2] for o in sim.spec.objects if o.name != obj]
     if not others:
         return 0.0
-    best, best_gap = 0.0, -1.0
+    gaps = {}
     for yaw in np.linspace(0.0, np.pi, 8, endpoint=False):
         axis = np.array([-np.sin(yaw), np.cos(yaw)])
         fingers = [centre + 0.05 * axis, centre - 0.05 * axis]
-        gap = min(float(np.linalg.norm(f - p)) for f in fingers for p in others)
-        if gap > best_gap + 1e-3:
-            best, best_gap = wrap_angle(float(yaw), np.pi), gap
-    return best
+        gaps[wrap_angle(float(yaw), np.pi)] = min(
+            float(np.linalg.norm(f - p)) for f in fingers for p in others
+        )
+    clear = [y for y, g in gaps.items() if g >= CLEAR_GAP]
+    if clear:
+        return min(clear, key=abs)
+    return max(gaps, key=lambda y: (round(gaps[y], 3), -abs(y)))
 
 
 def pick_phases(
