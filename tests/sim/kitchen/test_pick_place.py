@@ -31,6 +31,11 @@ def test_regions_tell_basin_counter_deck_and_air_apart():
     # on the faucet deck behind the basin: on the sink's footprint, not in a region
     centre = _world([0.16, 0.0, 0.1 + ball])
     assert locate(centre, centre[2] - ball, poses) is None
+    # on a stove's cooktop (4 cm high) standing beside the sink
+    stove = (np.array([0.15, 0.3, COUNTER_TOP]), -0.2)
+    centre = _world([0.0, -0.1, 0.04 + ball], stove)
+    assert locate(centre, centre[2] - ball, {**poses, "Stove": stove}) == ("on", "stove")
+    assert locate(centre, centre[2] - ball, poses) != ("on", "stove")
     # on the free counter beside it, and falling from 10 cm above the counter
     centre = np.array([-0.1, 0.25, COUNTER_TOP + ball])
     assert locate(centre, centre[2] - ball, poses) == ("on", "counter")
