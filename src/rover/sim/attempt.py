@@ -59,9 +59,14 @@ def trim_demo(
     keep = [0]
     idle = 0
     for t in range(1, last + 1):
-        if facts_changed(facts[keep[-1]], facts[t]) or t in must:
+        if facts_changed(facts[keep[-1]], facts[t]):
             keep.append(t)
             idle = 0
+        elif t in must:  # a still subtask end: kept, in place of the last still step
+            if idle >= IDLE_KEEP and keep[-1] not in must:
+                keep.pop()
+            keep.append(t)
+            idle = min(idle + 1, IDLE_KEEP)
         elif idle < IDLE_KEEP:
             keep.append(t)
             idle += 1
