@@ -194,7 +194,9 @@ def make_attempts(
                 expert_tracks[d], steps, expert_tracks[d], spec.subtasks, bounds,
                 goal_end=int(ends[-1]), form=form,  # type: ignore[arg-type]
             )  # fmt: skip
-        band = progress_band(level, spec.milestones, marks[key], marks[pkey])
+        band = None
+        if window is not None:  # cut by milestone: the level's own band
+            band = progress_band(level, spec.milestones, marks[key], marks[pkey])
         if band is None:  # no milestone marks: the level below's subtask fraction
             band = (_floor(below, marks[pkey], bounds), 1.0)
         pre_tracks = point_tracks(sim, prefix.states, names, signals)
