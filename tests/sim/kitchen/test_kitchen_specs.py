@@ -76,7 +76,7 @@ def test_kitchen_suite_registered_beside_tabletop():
     for name in kitchen:
         spec = get_task(name)
         assert spec.suite == "kitchen" and spec.env_name == "RoverKitchen"
-        assert spec.group in ("doors_drawers", "appliances", "fixtures_knobs")
+        assert spec.group in ("pick_and_place", "doors_drawers", "appliances", "fixtures_knobs")
         assert len(spec.paraphrases) >= 2
     with pytest.raises(InputError, match="valid suites"):
         task_names("garden")
