@@ -116,8 +116,12 @@ def swing_script(sim: SimEnv) -> list[Phase]:
     def along() -> np.ndarray:
         return fx.site_at(site, _ahead(fx, SWING_LEAD))
 
-    hold, rest = latch(sim), latch(sim)
+    hold, rest, start = latch(sim), latch(sim), latch(sim)
+    # the sink spout's arm reaches out over the basin toward the hand's start pose: rise
+    # above it first, or the hand sweeps it round on the way to its grip point
+    clear = [Phase(lambda: start() + np.array([0.0, 0.0, 0.1]), OPEN, tol=0.02, steps=30)]
     return [
+        *(clear if fx.kind == "spout" else []),
         *_grasp(handle, hold, part_yaw()),
         Phase(
             along,
