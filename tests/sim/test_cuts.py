@@ -211,3 +211,16 @@ def test_window_starts_once_every_earlier_component_is_shown():
     levels = {lv.level: lv for lv in get_task("PickPlaceCan").levels}
     assert cut_window(levels[6], COMPS, m, 30) == (36, 79)
     assert cut_window(levels[5], COMPS, m, 30) is None
+
+
+def test_a_pick_up_after_a_placement_is_a_general_band():
+    """Restock L3 ("placed the milk, not yet picked up the can") ends anywhere above the
+    placement less BAND_UNDO, not under a touched-not-held ceiling meant for contacts."""
+    from rover.sim.cuts import BAND_UNDO, progress_band
+
+    spec = get_task("Restock")
+    comps = spec.milestones
+    m = ExpertMarks(steps=(20, 40, 60, 80), holds={"milk": ((15, 40),)}, length=90)
+    expert = np.linspace(0.0, 1.0, 90)
+    level3 = next(lv for lv in spec.levels if lv.level == 3)
+    assert progress_band(level3, comps, m, expert) == pytest.approx((expert[40] - BAND_UNDO, 1.0))

@@ -164,6 +164,9 @@ def progress_band(
     * "picked up, not carried" lets go, and the object lies where it was touched: at
       least `BAND_GAP` below the contact.
 
+    The touched-not-held band needs the contact right before: Restock's "placed the milk,
+    not yet picked up the can" is a general level (its achievement is a placement).
+
     None when the demo does not show the components the band reads.
     """
     L = level.level
@@ -186,7 +189,8 @@ def progress_band(
     if kind == "contact":
         nxt = at(L - 1)
         return max(here - BAND_UNDO, 0.0), 1.0 if nxt is None else (here + nxt) / 2
-    if kind in ("pick_up", "grasp", "start"):
+    after_contact = component_kind(components[L - 2]) == "contact"
+    if kind in ("pick_up", "grasp", "start") and after_contact:
         before = at(L - 3)
         if before is None:
             return None
