@@ -29,3 +29,13 @@ def test_a_closing_drawer_is_measured_toward_closed_and_unfinished_moves_are_ski
     # no articulated part, or progress of another length: nothing to check
     assert joint_lags([FrameFacts()] * 3, [0.0, 0.0, 0.0]) == []
     assert joint_lags(_facts([0.0, 1.0]), [0.0]) == []
+
+
+def test_a_button_clicking_between_two_frames_is_not_a_lag():
+    """PressButton's expert: the finger comes down (progress 0.82), the button clicks
+    fully in between frames 27 and 28; a two-frame press is still checked."""
+    click = [0.0] * 28 + [1.0, 1.0]
+    progress = [t / 33 for t in range(28)] + [1.0, 1.0]
+    assert joint_lags(_facts(click, "button"), progress) == []
+    two = [0.0] * 27 + [0.5, 1.0, 1.0]
+    assert joint_lags(_facts(two, "button"), progress)

@@ -104,7 +104,10 @@ def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
     jump when the hand lets go. The way toward the goal is read from the first frame (a
     part starting above half way, an open drawer to close, is measured by 1 - fraction);
     the gain is taken from the last frame at most `JOINT_START` of the way to the first
-    frame at least `JOINT_FINISH` of it."""
+    frame at least `JOINT_FINISH` of it. A part that goes the whole way between two
+    consecutive frames (a button's click) is skipped: there is no motion in the video for
+    progress to follow, and what the press subtask earned before it (the finger coming
+    down onto the button) is honest progress."""
     out = []
     if not facts or len(progress) != len(facts):
         return out
@@ -117,8 +120,8 @@ def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
         if done is None:
             continue
         start = next((t for t in range(done - 1, -1, -1) if way[t] <= JOINT_START), None)
-        if start is None:
-            continue
+        if start is None or done - start < 2:
+            continue  # (a part that clicks between two sampled frames has no way to follow)
         gain = progress[done] - progress[start]
         if gain < JOINT_GAIN:
             out.append(
