@@ -20,6 +20,7 @@ from rich.table import Table
 
 from rover.console import esc, line, make_console
 from rover.errors import InputError
+from rover.exec.options import RayAddressOpt
 from rover.paths import check_output_dir
 from rover.vlm import cli_options as vo
 
@@ -84,13 +85,7 @@ def eval_command(
     executor: Annotated[
         str, typer.Option("--executor", help="Where work units run: 'local' or 'ray'.")
     ] = "local",
-    ray_address: Annotated[
-        str | None,
-        typer.Option(
-            "--ray-address",
-            help="--executor ray: 'auto' or host:port of a running cluster (default: a local Ray).",
-        ),
-    ] = None,
+    ray_address: RayAddressOpt = None,
     limit: Annotated[int | None, typer.Option("--limit", help="Only the first N episodes.")] = None,
     episodes: Annotated[
         int | None,

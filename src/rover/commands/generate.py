@@ -12,6 +12,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from rover.console import esc, make_console
 from rover.errors import InputError
+from rover.exec.options import RayAddressOpt
 from rover.paths import check_output_dir
 
 MAX_SIZE = 1024  # px: the offscreen framebuffer grows with the square of the size
@@ -37,13 +38,7 @@ def generate_command(
     executor: Annotated[
         str, typer.Option("--executor", help="Where episodes run: 'local' (--workers) or 'ray'.")
     ] = "local",
-    ray_address: Annotated[
-        str | None,
-        typer.Option(
-            "--ray-address",
-            help="--executor ray: 'auto' or host:port of a running cluster (default: a local Ray).",
-        ),
-    ] = None,
+    ray_address: RayAddressOpt = None,
     demos: Annotated[int, typer.Option(help="Expert demonstrations per task.")] = 3,
     source_hdf5: Annotated[
         Path | None,

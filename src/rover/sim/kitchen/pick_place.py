@@ -19,13 +19,7 @@ the questions, which stay fixed per task while the instance changes with the see
 from __future__ import annotations
 
 from rover.sim.kitchen.items import host_body
-from rover.sim.tasks._common import (
-    grasp_subtask,
-    move_subtask,
-    pick_place_levels,
-    pick_place_milestones,
-    pick_place_qa,
-)
+from rover.sim.tasks._common import pick_place_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
 
 SUITE = "kitchen"
@@ -70,18 +64,9 @@ def pick_place(name: str, category: str, start: str, goal: str) -> TaskSpec:
         description=f"Pick the {obj} from {FROM[start]} and place it {target}.",
         paraphrases=_paraphrases(obj, start, goal),
         suite=SUITE,
-        group="pick_and_place",
         objects=[ObjectSpec(name=obj, body=host_body(category))],
         goals={"region": GoalSpec(kind="body", body=site, offset=offset)},
-        subtasks=[
-            grasp_subtask(f"pick up the {obj}", obj),
-            move_subtask(f"place the {obj} {target}", obj, "goal:region", f"placed:{obj}"),
-        ],
-        levels=pick_place_levels(obj, target),
-        milestones=pick_place_milestones(obj),
-        qa_templates=pick_place_qa(obj, target),
-        expert="pick_place",
-        max_expert_steps=500,
+        **pick_place_protocol(obj, target, "goal:region"),
     )
 
 

@@ -72,6 +72,32 @@ def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
     return by_milestone(levels, pick_place_milestones(obj))
 
 
+def pick_place_protocol(
+    obj: str,
+    target: str,
+    goal: str,
+    signal: str | None = None,
+    point: str | None = None,
+    expert: str = "pick_place",
+) -> dict:
+    """The spec fields every pick-and-place task shares (tabletop bins and pegs, kitchen
+    regions): the two object-centric subtasks, Table 5's seven levels and milestones, the
+    App. C.3 questions and the expert. ``goal`` names the task's goal ("goal:bin"),
+    ``signal`` its end test (default ``placed:<obj>``), ``point`` where the object is taken."""
+    return {
+        "group": "pick_and_place",
+        "subtasks": [
+            grasp_subtask(f"pick up the {obj}", obj, point=point),
+            move_subtask(f"place the {obj} {target}", obj, goal, signal or f"placed:{obj}"),
+        ],
+        "levels": pick_place_levels(obj, target),
+        "milestones": pick_place_milestones(obj),
+        "qa_templates": pick_place_qa(obj, target),
+        "expert": expert,
+        "max_expert_steps": 500,
+    }
+
+
 def pick_place_milestones(obj: str) -> list[str]:
     """The six components separating the seven pick-and-place levels."""
     return [

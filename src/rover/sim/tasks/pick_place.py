@@ -2,13 +2,7 @@
 
 from __future__ import annotations
 
-from rover.sim.tasks._common import (
-    grasp_subtask,
-    move_subtask,
-    pick_place_levels,
-    pick_place_milestones,
-    pick_place_qa,
-)
+from rover.sim.tasks._common import pick_place_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
 
 # robosuite PickPlace: object -> compartment index of the target bin (object_to_id)
@@ -27,19 +21,10 @@ def pick_place_task(obj: str) -> TaskSpec:
         name=f"PickPlace{obj.capitalize()}",
         env_name=f"PickPlace{obj.capitalize()}",
         description=f"Pick up the {obj} and place it {target}.",
-        group="pick_and_place",
         objects=[ObjectSpec(name=obj, body=BODY_OF[obj])],
         goals={"bin": GoalSpec(kind="bin", object=obj)},
         bins={obj: BIN_OF[obj]},
-        subtasks=[
-            grasp_subtask(f"pick up the {obj}", obj),
-            move_subtask(f"place the {obj} {target}", obj, "goal:bin", f"placed:{obj}"),
-        ],
-        levels=pick_place_levels(obj, target),
-        milestones=pick_place_milestones(obj),
-        qa_templates=pick_place_qa(obj, target),
-        expert="pick_place",
-        max_expert_steps=500,
+        **pick_place_protocol(obj, target, "goal:bin"),
     )
 
 
@@ -52,7 +37,6 @@ def nut_task(shape: str) -> TaskSpec:
         name=f"NutAssembly{cap}",
         env_name=f"NutAssembly{cap}",
         description=f"Pick up the {nut} by its handle and put it {target}.",
-        group="pick_and_place",
         objects=[
             ObjectSpec(
                 name=nut,
@@ -63,15 +47,9 @@ def nut_task(shape: str) -> TaskSpec:
             ObjectSpec(name="peg", body=peg, graspable=False),
         ],
         goals={"peg": GoalSpec(kind="body", body=peg, offset=(0.0, 0.0, 0.0))},
-        subtasks=[
-            grasp_subtask(f"pick up the {nut}", nut, point=f"{nut}:handle"),
-            move_subtask(f"place the {nut} {target}", nut, "goal:peg", f"on_peg:{nut}"),
-        ],
-        levels=pick_place_levels(nut, target),
-        milestones=pick_place_milestones(nut),
-        qa_templates=pick_place_qa(nut, target),
-        expert="nut",
-        max_expert_steps=500,
+        **pick_place_protocol(
+            nut, target, "goal:peg", f"on_peg:{nut}", point=f"{nut}:handle", expert="nut"
+        ),
     )
 
 
