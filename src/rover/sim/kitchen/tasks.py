@@ -16,7 +16,7 @@ import numpy as np
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
 from rover.sim.levels import by_milestone
-from rover.sim.tasks._common import FINGERS, named_levels
+from rover.sim.tasks._common import FINGERS, door_opening_levels, named_levels
 from rover.sim.tasks.articulated import drawer_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
@@ -99,16 +99,7 @@ OPEN_SINGLE_DOOR = _spec(
         _reach("grasp the door handle", "door", "door:handle", "grasped:door"),
         _move("swing the door open", "door", "door:handle", "goal:door_swung", "turned:door"),
     ],
-    levels=named_levels(
-        [["Approach the door"], ["Start opening the door"]],
-        [
-            "Fail to approach the door",
-            "Approach the door",
-            "Contact the door",
-            "Start opening the door",
-            "Finish opening the door",
-        ],
-    ),
+    levels=door_opening_levels(),
     milestones=["approach:door", "contact:door", "open_start:door", "open_finish:door"],
     qa_templates=_qa(
         "door",

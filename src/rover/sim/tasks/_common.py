@@ -39,6 +39,21 @@ def named_levels(milestones: Sequence[Sequence[str]], names: Sequence[str]) -> l
     return [lv.model_copy(update={"name": n}) for lv, n in zip(levels, names, strict=True)]
 
 
+def door_opening_levels() -> list[LevelSpec]:
+    """Table 5's doors group for opening a hinged door (tabletop Door, kitchen
+    OpenSingleDoor): five levels, from failing to approach to finishing the swing."""
+    return named_levels(
+        [["Approach the door"], ["Start opening the door"]],
+        [
+            "Fail to approach the door",
+            "Approach the door",
+            "Contact the door",
+            "Start opening the door",
+            "Finish opening the door",
+        ],
+    )
+
+
 def contact_before_grasp(levels: list[LevelSpec], level: int = 3) -> list[LevelSpec]:
     """An articulated task's "contact" level stops near the end of the grasp subtask
     (fingers at the handle, not yet closed on it) instead of just after the grasp: random

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from rover.sim.levels import by_milestone
-from rover.sim.tasks._common import FINGERS, contact_before_grasp, named_levels
+from rover.sim.tasks._common import FINGERS, contact_before_grasp, door_opening_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 MILESTONES = ["approach:door", "contact:door", "open_start:door", "open_finish:door"]
@@ -39,18 +39,7 @@ DOOR = TaskSpec(
         ),
     ],
     levels=by_milestone(
-        contact_before_grasp(
-            named_levels(
-                [["Approach the door"], ["Start opening the door"]],
-                [
-                    "Fail to approach the door",
-                    "Approach the door",
-                    "Contact the door",
-                    "Start opening the door",
-                    "Finish opening the door",
-                ],
-            )
-        ),
+        contact_before_grasp(door_opening_levels()),
         MILESTONES,
     ),
     milestones=MILESTONES,
