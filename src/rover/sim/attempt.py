@@ -183,6 +183,10 @@ def make_attempts(
         if terminal is not None:
             drift = level.terminal_drift if any(level.terminal_drift) else None
             terminal = replace(terminal, grip=_grip(level, actions, terminal.q), drift=drift)
+            lo, hi = level.terminal_settle
+            if hi > 0:  # lowered in the grasp first (its own draw: other levels unchanged)
+                settle = int(rng.integers(lo, hi + 1))
+                terminal = replace(terminal, w=terminal.w + settle, settle=settle)
         head = replace(plan, segments=plan.segments[:-1]) if terminal is not None else plan
         prefix = execute_plan(sim, states, actions, head, act_rng)
         if d not in expert_tracks:
@@ -209,7 +213,14 @@ def make_attempts(
                 if e:  # a fresh ending, each a little gentler than the last
                     w = int(rng.integers(level.terminal_w[0], level.terminal_w[1] + 1))
                     seg = RandomSegment(
-                        seg.q, w, seg.scale * 0.8**e, min(seg.hold, w), 0, seg.grip, seg.drift
+                        seg.q,
+                        w + seg.settle,
+                        seg.scale * 0.8**e,
+                        min(seg.hold, w),
+                        0,
+                        seg.grip,
+                        seg.drift,
+                        seg.settle,
                     )
                 tail_plan = TrajectoryPlan(
                     plan.expert_len, plan.subtask_bounds, (seg,), plan.level, True

@@ -121,6 +121,8 @@ def cut_window(
     if kind in ("pick_up", "grasp", "start"):
         hold = _hold_after(marks, obj, lo)
         if hold is not None and hold[0] >= lo:  # (at the contact itself when both coincide)
+            if kind == "pick_up" and hold[0] == lo and lo > 0:
+                return None  # the hold starts with the contact: nothing touched-not-held
             hi = min(hi, max(hold[0] - 1, lo))
     elif kind == "place":
         hold = _hold_after(marks, obj, lo)
@@ -190,6 +192,26 @@ def progress_band(
         nxt = at(L - 1)
         return max(here - BAND_UNDO, 0.0), 1.0 if nxt is None else (here + nxt) / 2
     after_contact = component_kind(components[L - 2]) == "contact"
+    if kind == "pick_up" and after_contact and level.terminal_drift[2] > 0:
+        before = at(L - 3)
+        if before is None:
+            return None
+        # touched, not held, the open hand backing off upwards (the pick-and-place
+        # ending): from half `BAND_UNDO` under the approach up to the contact. The
+        # approach and the contact are often only 0.02-0.05 apart in progress, too
+        # close to hold a random ending above their midpoint
+        return max(before - BAND_UNDO / 2, 0.0), here
+    if kind == "carry" and level.terminal_settle[1] > 0:
+        # set back down in the grasp, then let go with the open hand at it (the
+        # pick-and-place ending): an open hand at the object is worth about what it
+        # was at the contact, a little more or less with where the fingers are (the
+        # closed fingers were part of the grasp's value); above the midpoint of the
+        # approach and the contact (where a touched-not-held hand that backs off ends)
+        # and below the pick-up (it is not carried)
+        app, con, pick = at(L - 4), at(L - 3), at(L - 2)
+        if app is None or con is None or pick is None:
+            return None
+        return (app + con) / 2, max(pick - BAND_GAP, 0.0)
     if kind in ("pick_up", "grasp", "start") and after_contact:
         before = at(L - 3)
         if before is None:

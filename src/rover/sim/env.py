@@ -22,6 +22,7 @@ from rover.sim.tasks.base import TaskSpec
 
 CONTROL_FREQ = 20  # Hz; the expert and every deviation step run at this rate
 LIFT_HEIGHT = 0.04  # m above its start height for an object to count as lifted
+SETTLE_STEPS = 200  # physics steps (0.4 s) a start position is let fall for, robot held
 
 
 def _import_robosuite():
@@ -162,7 +163,7 @@ class SimEnv:
         self.data.qpos[self._finger_qpos[1]] = -0.04
         self.data.qacc_warmstart[:] = 0.0
         self.sim.forward()
-        self.start_positions = {o.name: self.point(o.name).copy() for o in self.spec.objects}
+        self.start_positions = self._rest_positions()
         return self.get_state()
 
     def begin(self, state: np.ndarray) -> None:
@@ -175,7 +176,24 @@ class SimEnv:
                 f"environment (expected {self.get_state().shape[0]}); wrong --source-hdf5?"
             )
         self.set_state(state)
-        self.start_positions = {o.name: self.point(o.name).copy() for o in self.spec.objects}
+        self.start_positions = self._rest_positions()
+
+    def _rest_positions(self) -> dict[str, np.ndarray]:
+        """Where each task object comes to rest from the current state, the robot held
+        still (the state is restored). "Lifted" and "on the table" are measured from an
+        object's start, and robosuite drops some objects into the scene: NutAssembly's
+        nuts appear 6 cm above the table and fall in a demo's first steps, so a nut had
+        to be 10 cm off the table to count as lifted and never read as on it."""
+        saved = self.get_state()
+        qpos, qvel = self.robot_qpos, self.robot_qvel
+        hold_q, hold_v = self.data.qpos[qpos].copy(), self.data.qvel[qvel].copy()
+        try:
+            for _ in range(SETTLE_STEPS):
+                mujoco.mj_step(self.model, self.data)
+                self.data.qpos[qpos], self.data.qvel[qvel] = hold_q, hold_v
+            return {o.name: self.point(o.name).copy() for o in self.spec.objects}
+        finally:
+            self.set_state(saved)
 
     # ------------------------------------------------------------ SimAdapter
     def get_state(self) -> np.ndarray:
@@ -381,10 +399,16 @@ class SimEnv:
 
         Looser than `predicate`, which marks the moment a subtask ends: a grasp stands
         while any finger touches the object, a placement while the object lies in its
-        goal (touched or not); pressing a button or touching it cannot be undone.
+        goal (touched or not); pressing a button or touching it cannot be undone. A
+        pick-up ("lifted") stands while both fingers hold the object, or while it is
+        still off its start with a finger on it: one finger brushing an object set back
+        on the table is not a pick-up (such endings were valued as carried, at 0.50).
         """
         kind, _, obj = signal.partition(":")
-        if kind in ("grasped", "lifted"):
+        if kind == "lifted":
+            touching = self.finger_contacts().get(obj, set())
+            return touching == {"left", "right"} or (bool(touching) and self.lifted(obj))
+        if kind == "grasped":
             return obj in self.finger_contacts()
         if kind == "placed" and "region" in self.spec.goals:
             return self.env.item_in_goal()

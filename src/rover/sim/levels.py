@@ -12,7 +12,7 @@ points and recovery smoothness (Sec. 4.1, "we ensure diversity ...").
 from __future__ import annotations
 
 import zlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Literal
 
 import numpy as np
@@ -57,6 +57,11 @@ class LevelSpec(BaseModel):
         terminal_drift: added to the final deviation's x, y, z action channels (then
             clipped): (0, 0, -0.5) sets a just-lifted object back down as the fingers
             open instead of dropping it; (0, 0, 0.3) backs the open hand off upwards.
+        terminal_settle: steps before the final deviation's random ones that keep the
+            gripper closed and move the hand by ``terminal_drift`` alone, which then
+            stops (0: none, the paper): a just-lifted object is lowered back to the
+            table in the grasp and only then let go, so the open hand stays at it (the
+            hand cannot come back down as fast as a released object falls).
     """
 
     level: int = Field(ge=1)
@@ -74,10 +79,19 @@ class LevelSpec(BaseModel):
     milestone_cut: FloatRange | None = None
     terminal_grip: Grip = "random"
     terminal_drift: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    terminal_settle: IntRange = (0, 0)
 
     @model_validator(mode="after")
     def _ranges_ordered(self) -> LevelSpec:
-        for field in ("terminate_at", "terminal_w", "deviations", "w", "scale", "hold"):
+        for field in (
+            "terminate_at",
+            "terminal_w",
+            "deviations",
+            "w",
+            "scale",
+            "hold",
+            "terminal_settle",
+        ):
             lo, hi = getattr(self, field)
             if lo > hi or lo < 0:
                 raise ValueError(f"level {self.level}: {field} must be 0 <= low <= high")
@@ -245,17 +259,24 @@ def component_kind(component: str) -> str:
     return kind
 
 
-def by_milestone(levels: Sequence[LevelSpec], components: Sequence[str]) -> list[LevelSpec]:
+def by_milestone(
+    levels: Sequence[LevelSpec],
+    components: Sequence[str],
+    endings: Mapping[str, dict] | None = None,
+) -> list[LevelSpec]:
     """Levels cut by milestone: level L leaves the expert between the demo's achievement
     of component L-1 and of component L, with the ending `ENDINGS_BY_KIND` gives
     component L's kind. The subtask-fraction knobs stay as the fallback, so a level
-    still plans without a demo's milestone steps."""
+    still plans without a demo's milestone steps. ``endings`` replaces the ending of
+    some kinds for one task group (free objects need other endings than handles: see
+    `rover.sim.tasks._common.PICK_PLACE_ENDINGS`)."""
+    table = {**ENDINGS_BY_KIND, **(endings or {})}
     out = []
     for lv in levels:
         if lv.completes or lv.level - 1 >= len(components):
             out.append(lv)
             continue
-        knobs = ENDINGS_BY_KIND.get(component_kind(components[lv.level - 1]), _DEFAULT_ENDING)
+        knobs = table.get(component_kind(components[lv.level - 1]), _DEFAULT_ENDING)
         out.append(lv.model_copy(update=dict(knobs)))
     return out
 

@@ -58,6 +58,10 @@ class RandomSegment:
     depth: int = 0
     grip: float | None = None  # gripper command held throughout (None: random like the rest)
     drift: tuple[float, float, float] | None = None  # added to the x, y, z channels
+    # the first `settle` of the w steps keep the gripper closed and move the hand by the
+    # drift alone (no random part, no `grip`): a just-lifted object is set back down
+    # before the fingers open; the drift then stops, so the open hand stays at it
+    settle: int = 0
 
 
 @dataclass(frozen=True)
@@ -331,11 +335,16 @@ def execute_plan(
             adapter.set_state(states[-1] if states else expert_states[seg.q])
             action = None
             for i in range(seg.w):
-                if action is None or i % seg.hold == 0:
+                if i < seg.settle:
+                    action = random_action(rng, adapter.action_low, adapter.action_high, 0.0)
+                    action[-1] = 1.0
+                    if seg.drift is not None:
+                        action[:3] = np.clip(action[:3] + np.asarray(seg.drift), -1.0, 1.0)
+                elif i == seg.settle > 0 or action is None or (i - seg.settle) % seg.hold == 0:
                     action = random_action(rng, adapter.action_low, adapter.action_high, seg.scale)
                     if seg.grip is not None:  # the last channel is the gripper's
                         action[-1] = seg.grip
-                    if seg.drift is not None:  # the first three move the hand
+                    if seg.drift is not None and not seg.settle:  # the first three move the hand
                         action[:3] = np.clip(action[:3] + np.asarray(seg.drift), -1.0, 1.0)
                 adapter.step(action)
                 j_total += 1

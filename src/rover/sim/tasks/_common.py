@@ -67,6 +67,44 @@ def contact_before_grasp(levels: list[LevelSpec], level: int = 3) -> list[LevelS
     ]
 
 
+# How a pick-and-place level ends before its next component (replacing those kinds of
+# `rover.sim.levels.ENDINGS_BY_KIND`; see docs/generate.md, "Pick-and-place levels"). The
+# value of the pick-up subtask changes by a few hundredths between the approach, the
+# contact and the grasp (it is normalised over the whole reach), so each ending leaves
+# a state whose value sits where its level belongs, by construction rather than by luck:
+# approached, not touched: leave early in the stretch, the open hand backing off upwards
+# (random motion beside a small cube or in a sink basin touched the object)
+# touched, not held: leave before the fingers close, lift the open hand a few cm off the
+# object (never dragging or knocking it), so it ends below the contact
+# picked up, not carried: open at the lift while lowering the hand, so the object is set
+# back down between the fingers and the hand stays at it: the pick-up undone with the
+# hand where it grasped, valued as the grasp (above the contact, which the hand left)
+PICK_PLACE_ENDINGS: dict[str, dict] = {
+    "contact": {
+        "milestone_cut": (0.0, 0.3),
+        "terminal_grip": "open",
+        "terminal_w": (8, 14),
+        "scale": (0.05, 0.15),
+        "terminal_drift": (0.0, 0.0, 0.3),
+    },
+    "pick_up": {
+        "milestone_cut": (0.0, 0.4),
+        "terminal_grip": "open",
+        "terminal_w": (10, 16),
+        "scale": (0.0, 0.1),
+        "terminal_drift": (0.0, 0.0, 0.3),
+    },
+    "carry": {
+        "milestone_cut": (0.0, 0.2),
+        "terminal_grip": "open",
+        "terminal_settle": (10, 16),
+        "terminal_w": (8, 12),
+        "scale": (0.0, 0.05),
+        "terminal_drift": (0.0, 0.0, -1.0),
+    },
+}
+
+
 def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
     """App. B Table 5, pick-and-place group: seven levels, cut by milestone."""
     levels = named_levels(
@@ -84,7 +122,7 @@ def pick_place_levels(obj: str, target: str) -> list[LevelSpec]:
             f"Place the {obj} {target}",
         ],
     )
-    return by_milestone(levels, pick_place_milestones(obj))
+    return by_milestone(levels, pick_place_milestones(obj), PICK_PLACE_ENDINGS)
 
 
 def pick_place_protocol(

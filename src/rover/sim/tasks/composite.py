@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from rover.sim.levels import by_milestone, default_levels
-from rover.sim.tasks._common import grasp_subtask, move_subtask, pick_place_qa
+from rover.sim.tasks._common import PICK_PLACE_ENDINGS, grasp_subtask, move_subtask, pick_place_qa
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
 from rover.sim.tasks.pick_place import BIN_OF, BODY_OF, bin_name
 
@@ -39,7 +39,7 @@ def restock_task(items: tuple[str, ...] = ITEMS) -> TaskSpec:
         goals={f"bin_{o}": GoalSpec(kind="bin", object=o) for o in items},
         bins={o: BIN_OF[o] for o in items},
         subtasks=subtasks,
-        levels=by_milestone(levels, milestones),
+        levels=by_milestone(levels, milestones, PICK_PLACE_ENDINGS),
         milestones=milestones,
         qa_templates=qa,
         frames=60,

@@ -3,7 +3,12 @@
 from __future__ import annotations
 
 from rover.sim.levels import by_milestone
-from rover.sim.tasks._common import grasp_subtask, move_subtask, named_levels
+from rover.sim.tasks._common import (
+    PICK_PLACE_ENDINGS,
+    grasp_subtask,
+    move_subtask,
+    named_levels,
+)
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, TaskSpec
 
 MILESTONES = ["approach:cube", "contact:cube", "pick_up:cube"]
@@ -30,6 +35,7 @@ LIFT = TaskSpec(
             ],
         ),
         MILESTONES,
+        PICK_PLACE_ENDINGS,
     ),
     milestones=MILESTONES,
     qa_templates=[
