@@ -173,7 +173,23 @@ def make_attempts(
         sim.begin(states[0])  # start positions (lift heights, goals) of this demo
         bounds = bounds_from_ends(ends, len(states))
         key = _demo_key(d, states)
+        if d not in expert_tracks:
+            expert_tracks[d] = point_tracks(sim, states, names)
+        pkey = ("progress", key, form)
+        if pkey not in marks:  # the expert's own progress per step
+            steps = np.arange(len(states))
+            marks[pkey] = progress_from_tracks(
+                expert_tracks[d], steps, expert_tracks[d], spec.subtasks, bounds,
+                goal_end=int(ends[-1]), form=form,  # type: ignore[arg-type]
+            )  # fmt: skip
         window = cut_window(level, spec.milestones, marks[key], frames)
+        band = None
+        if window is not None:  # cut by milestone: the level's own band
+            band = progress_band(level, spec.milestones, marks[key], marks[pkey])
+            window = within_band(window, marks[pkey], band)
+            window = _touching(sim, spec, level, states, window, marks, key)
+        if band is None:  # no milestone marks: the level below's subtask fraction
+            band = (_floor(below, marks[pkey], bounds), 1.0)
         cut = draw_cut(window, level, rng) if window is not None else None
         plan = plan_trajectory(
             len(states), bounds, level, rng, cut=cut, deviate_before=window and window[0]
@@ -189,20 +205,6 @@ def make_attempts(
                 terminal = replace(terminal, w=terminal.w + settle, settle=settle)
         head = replace(plan, segments=plan.segments[:-1]) if terminal is not None else plan
         prefix = execute_plan(sim, states, actions, head, act_rng)
-        if d not in expert_tracks:
-            expert_tracks[d] = point_tracks(sim, states, names)
-        pkey = ("progress", key, form)
-        if pkey not in marks:  # the expert's own progress per step
-            steps = np.arange(len(states))
-            marks[pkey] = progress_from_tracks(
-                expert_tracks[d], steps, expert_tracks[d], spec.subtasks, bounds,
-                goal_end=int(ends[-1]), form=form,  # type: ignore[arg-type]
-            )  # fmt: skip
-        band = None
-        if window is not None:  # cut by milestone: the level's own band
-            band = progress_band(level, spec.milestones, marks[key], marks[pkey])
-        if band is None:  # no milestone marks: the level below's subtask fraction
-            band = (_floor(below, marks[pkey], bounds), 1.0)
         pre_tracks = point_tracks(sim, prefix.states, names, signals)
         endings = ENDINGS if terminal is not None else 1
         for e in range(endings):
@@ -261,6 +263,71 @@ def make_attempts(
             yield Attempt(tries, d, roll, prog, pos, facts, events, problems)
             if roll.recovery_gap > RECOVERY_GAP or tries >= MAX_TRIES:
                 break  # the prefix itself is at fault: plan again
+            if problems and _prefix_shows_next(spec, level, facts, pos, len(prefix)):
+                break  # (a recovered deviation did it: no ending can take it back)
+
+
+def within_band(
+    window: tuple[int, int], expert: np.ndarray, band: tuple[float, float] | None
+) -> tuple[int, int]:
+    """The part of a cut window whose expert steps lie inside the level's progress band.
+
+    The window is drawn by milestone steps, but expert progress is not linear in steps
+    (the hand creeps the last centimetres to a handle): a cut late in the "approached,
+    not touched" stretch could already stand above that level's ceiling, and every
+    ending drawn from it failed the band. Cutting where the expert itself is in the band
+    makes the level constructive rather than found by resampling. The whole window when
+    no step of it is in the band (the band check then decides, as before).
+    """
+    if band is None:
+        return window
+    lo, hi = window
+    ok = [t for t in range(lo, hi + 1) if band[0] <= float(expert[t]) <= band[1]]
+    return (ok[0], ok[-1]) if ok else window
+
+
+def _touching(sim, spec: TaskSpec, level: LevelSpec, states, window, marks: dict, key):
+    """A level that follows a "contact" component leaves the expert at a step where the
+    fingers touch the object, when the window has such steps.
+
+    The expert's first touch is often a brush (a finger grazes the drawer's bar on the
+    way down, then loses it until the fingers close), so a cut drawn anywhere after it
+    could fall where nothing touches, and the video, whose frames missed the brush,
+    never showed the contact its level needs.
+    """
+    L = level.level
+    if L < 2 or L - 2 >= len(spec.milestones):
+        return window
+    kind, _, obj = spec.milestones[L - 2].partition(":")
+    if kind != "contact":
+        return window
+    tkey = ("touch", key, obj)
+    if tkey not in marks:
+        saved = sim.get_state()
+        touch = []
+        for s in states:
+            sim.set_state(s)
+            touch.append(obj in sim.finger_contacts())
+        sim.set_state(saved)
+        marks[tkey] = np.asarray(touch, dtype=bool)
+    lo, hi = window
+    ok = np.flatnonzero(marks[tkey][lo : hi + 1]) + lo
+    return (int(ok[0]), int(ok[-1])) if len(ok) else window
+
+
+def _prefix_shows_next(spec: TaskSpec, level: LevelSpec, facts, pos, n_prefix: int) -> bool:
+    """Whether the video's frames before the final deviation already show the level's
+    next component (a recovered deviation pushed the door ajar): redrawing the ending
+    cannot help, so the try plans afresh."""
+    from rover.sim.facts import detect_events
+    from rover.sim.milestones import achieved
+
+    if level.completes or level.level - 1 >= len(spec.milestones):
+        return False
+    k = sum(1 for p in pos if p < n_prefix)
+    head = list(facts[:k])
+    nxt = spec.milestones[level.level - 1]
+    return bool(head) and achieved(nxt, head, detect_events(spec, head))
 
 
 def _demo_key(d: int, states: np.ndarray) -> tuple[int, int, int]:

@@ -151,6 +151,24 @@ BAND_UNDO = 0.1  # progress an ending may lose below the component the level ach
 BAND_GAP = 0.02  # "moved off": a touched-not-held level ends this far below the contact
 
 
+# articulated: a "contact" video may end this far under the expert at the contact, as
+# any ending may undo `BAND_UNDO` of what its level achieved
+TOUCH_GAP = BAND_UNDO
+
+
+def touch_line(approach: float, contact: float) -> float:
+    """The progress between an articulated part's "approached, not touched" videos (below)
+    and its "touched, not started" ones (above): half way from the expert's progress at
+    the approach to that at the contact, but at least `TOUCH_GAP` under the contact. The
+    contact level's ending rests the open hand at the handle or knob, worth a little less
+    than the expert's closing fingers, and the approach level's backs the hand off
+    (`rover.sim.levels.ENDINGS_BY_KIND`); where the expert's progress hardly changes
+    between the approach and the contact (a kitchen cabinet's handle) the
+    midpoint left the resting hand no room (its open fingers lose up to 0.08 against
+    the expert's closing ones)."""
+    return min((approach + contact) / 2, contact - TOUCH_GAP)
+
+
 def progress_band(
     level: LevelSpec, components: Sequence[str], marks: ExpertMarks, expert: np.ndarray
 ) -> tuple[float, float] | None:
@@ -190,8 +208,13 @@ def progress_band(
     here = float(expert[shown])
     if kind == "contact":
         nxt = at(L - 1)
+        if nxt is not None and L < len(components) and component_kind(components[L]) == "start":
+            return max(here - BAND_UNDO, 0.0), touch_line(here, nxt)  # (a handle or knob)
         return max(here - BAND_UNDO, 0.0), 1.0 if nxt is None else (here + nxt) / 2
     after_contact = component_kind(components[L - 2]) == "contact"
+    if kind == "start" and after_contact:
+        before = at(L - 3)
+        return None if before is None else (touch_line(before, here), 1.0)
     if kind == "pick_up" and after_contact and level.terminal_drift[2] > 0:
         before = at(L - 3)
         if before is None:

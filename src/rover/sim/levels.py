@@ -190,24 +190,29 @@ _PRE_GRASP = {"milestone_cut": (0.4, 0.9), "terminal_grip": "open", "terminal_w"
 ENDINGS_BY_KIND: dict[str, dict] = {
     # fail to approach: leave early, anything goes (as the paper)
     "approach": {"milestone_cut": (0.0, 0.2), "terminal_grip": "random"},
-    # approached, not touched: fingers open, move a little
+    # approached, not touched: fingers open, back off upwards a little (a few cm), so
+    # the video ends clearly short of a contact video's open hand resting at the part
     "contact": {
         "milestone_cut": (0.1, 0.5),
         "terminal_grip": "open",
-        "terminal_w": (10, 25),
-        "scale": (0.2, 0.5),
+        "terminal_w": (10, 20),
+        "scale": (0.1, 0.3),
+        "terminal_drift": (0.0, 0.0, 0.15),
     },  # fmt: skip
     # touched, not held: leave before the fingers close, keep them open, move away
     "pick_up": _PRE_GRASP,
     "grasp": _PRE_GRASP,
-    # any "<verb>_start": before the hand takes the handle or knob; back off upwards, as
-    # open fingers wandering at a handle push the door or drawer
+    # any "<verb>_start" (touched the handle or knob, not started moving it): leave before
+    # the fingers close and stay at the part, the fingers open, jittering a little and
+    # lifting ~1 cm so they do not push it. (Backing the hand off 10-30 cm, as before,
+    # ended the "contact" videos below the "approach" ones: the hand's distance to the
+    # part is what separates the two levels' progress; docs/generate.md)
     "start": {
         "milestone_cut": (0.4, 0.9),
         "terminal_grip": "open",
-        "terminal_w": (10, 25),
-        "scale": (0.2, 0.4),
-        "terminal_drift": (0.0, 0.0, 0.3),
+        "terminal_w": (6, 14),
+        "scale": (0.05, 0.15),
+        "terminal_drift": (0.0, 0.0, 0.05),
     },  # fmt: skip
     "press": {
         "milestone_cut": (0.2, 0.7),
