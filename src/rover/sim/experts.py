@@ -64,13 +64,19 @@ class Scripted:
         self.down = sim.data.site_xmat[sim._eef_site].reshape(3, 3).copy()
         self.yaw0 = 0.0
         self.tilt = 0.0  # rotation about world x applied before the yaw (door handle)
+        # rotation about world y applied before the yaw: -pi/2 points the hand forward
+        # (+x, fingers closing along y) for the forward grasp into low openings
+        self.pitch = 0.0
         self.states: list[np.ndarray] = []
         self.actions: list[np.ndarray] = []
 
     def rot_error(self, yaw: float) -> np.ndarray:
         """Axis-angle (world frame) from the current hand orientation to the wanted one."""
         cur = self.sim.data.site_xmat[self.sim._eef_site].reshape(3, 3)
-        want = Rotation.from_euler("zx", [yaw, self.tilt]).as_matrix() @ self.down
+        if self.pitch:
+            want = Rotation.from_euler("yz", [self.pitch, yaw]).as_matrix() @ self.down
+        else:
+            want = Rotation.from_euler("zx", [yaw, self.tilt]).as_matrix() @ self.down
         return Rotation.from_matrix(want @ cur.T).as_rotvec()
 
     def action(self, target: np.ndarray, grip: float, yaw: float, gain: float) -> np.ndarray:
