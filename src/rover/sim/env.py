@@ -368,6 +368,8 @@ class SimEnv:
             return self.grasped(obj)
         if kind == "lifted":
             return self.lifted(obj) and self.grasped(obj)
+        if kind == "placed" and hasattr(self.env, "object_in_goal"):  # a kitchen composite
+            return self.env.object_in_goal(obj) and not self.grasped(obj)
         if kind == "placed" and "region" in self.spec.goals:  # a kitchen goal region
             return self.env.item_in_goal() and not self.grasped(obj)
         if kind == "placed":
@@ -410,6 +412,8 @@ class SimEnv:
             return touching == {"left", "right"} or (bool(touching) and self.lifted(obj))
         if kind == "grasped":
             return obj in self.finger_contacts()
+        if kind == "placed" and hasattr(self.env, "object_in_goal"):
+            return self.env.object_in_goal(obj)
         if kind == "placed" and "region" in self.spec.goals:
             return self.env.item_in_goal()
         if kind == "placed":

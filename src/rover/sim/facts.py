@@ -124,7 +124,7 @@ def frame_facts(
 def _inside(sim: SimEnv, obj: str) -> str | None:
     if not sim.spec.object_spec(obj).graspable:
         return None
-    place = _kitchen_place(sim)
+    place = _kitchen_place(sim, obj)
     if place is not None:  # a kitchen item: the region it rests in (sink basin, ...)
         return place[1] if place[0] == "inside" else None
     if hasattr(sim.env, "not_in_bin"):  # robosuite PickPlace: the four target compartments
@@ -140,8 +140,11 @@ def _inside(sim: SimEnv, obj: str) -> str | None:
     return None
 
 
-def _kitchen_place(sim: SimEnv) -> tuple[str, str] | None:
+def _kitchen_place(sim: SimEnv, obj: str) -> tuple[str, str] | None:
     """A kitchen pick-and-place item's (relation, region); None elsewhere or when loose."""
+    per_item = getattr(sim.env, "object_place", None)
+    if per_item is not None:  # a kitchen composite: each of its items has its own place
+        return per_item(obj)
     where = getattr(sim.env, "item_place", None)
     return where() if where is not None else None
 
@@ -150,8 +153,9 @@ def _on(sim: SimEnv, obj: str, lifted: bool, held: bool) -> str | None:
     spec = sim.spec
     if not spec.object_spec(obj).graspable or held or _inside(sim, obj):
         return None
-    if getattr(sim.env, "item_category", None):  # a kitchen item: the surface region only
-        place = _kitchen_place(sim)
+    kitchen = getattr(sim.env, "item_category", None) or hasattr(sim.env, "object_place")
+    if kitchen:  # a kitchen item: the surface region only
+        place = _kitchen_place(sim, obj)
         return place[1] if place is not None and place[0] == "on" else None
     for other in spec.objects:
         if other.name != obj and other.graspable and sim.on_top(obj, other.name):
@@ -207,9 +211,21 @@ def target_reached(spec: TaskSpec, obj: str, f: FrameFacts) -> bool:
         return o.inside == "peg"
     if "on" in spec.goals:
         return o.on == spec.goals["on"].object
+    region = goal_region(spec, obj)
+    if region is not None:  # a kitchen composite's item: its own goal region
+        return region in (o.inside, o.on)
     if "region" in spec.goals:  # a kitchen goal region, named in the env's arguments
         return spec.env_kwargs.get("goal") in (o.inside, o.on)
     return False
+
+
+def goal_region(spec: TaskSpec, obj: str) -> str | None:
+    """The region a kitchen composite's item goes to (its env arguments' ``items`` rows:
+    name, category, start, goal); None for any other object or task."""
+    for row in spec.env_kwargs.get("items", ()):
+        if row[0] == obj:
+            return str(row[3])
+    return None
 
 
 def hold_spans(facts: list[FrameFacts], obj: str) -> list[tuple[int, int | None]]:
@@ -262,7 +278,8 @@ def detect_events(spec: TaskSpec, facts: list[FrameFacts]) -> list[Event]:
             drop = next((t for kind, t in ends if kind == "drop"), None)
             place = next((t for kind, t in ends if kind == "place"), None)
             events.append(Event(name="drop", object=name, frame=drop))
-            if spec.bins or "on" in spec.goals or "peg" in spec.goals or "region" in spec.goals:
+            goals = ("on", "peg", "region")
+            if spec.bins or any(g in spec.goals for g in goals) or goal_region(spec, name):
                 events.append(Event(name="place", object=name, frame=place))
         elif name == "door" and not articulation.closing(spec, name):
             events.append(

@@ -17,6 +17,7 @@ import numpy as np
 
 from rover.sim.env import SimEnv
 from rover.sim.experts_articulated import latch
+from rover.sim.kitchen.composite_experts import SCRIPTS as COMPOSITE_SCRIPTS
 from rover.sim.motions import CLOSE, OPEN, Phase, wrap_angle
 
 TURN_LEAD = 0.35  # rad the hand's yaw runs ahead of a dial while turning it
@@ -141,3 +142,4 @@ SCRIPTS: dict[str, Callable[[SimEnv], list[Phase]]] = {
     "kitchen_turn": turn_script,
     "kitchen_swing": swing_script,
 }
+SCRIPTS.update(COMPOSITE_SCRIPTS)  # chained experts of the composite tasks

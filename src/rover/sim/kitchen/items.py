@@ -23,18 +23,19 @@ HIDDEN_GROUP = 3  # render group of switched-off geoms (the renderer shows group
 DENSITY = 300.0  # kg/m^3, as the décor objects
 
 
-def host_body(category: str) -> str:
+def host_body(category: str, prefix: str = PREFIX) -> str:
     """MuJoCo name of the item body of a category (the first instance's robosuite body).
 
-    Pure naming (no robosuite import), so task specs can name it."""
+    Pure naming (no robosuite import), so task specs can name it. A scene with several
+    items (the composite tasks) gives each its own `prefix`."""
     first = instances(category)[0]
     suffix = "root" if first.shape in ("mug", "pan") else "main"
-    return f"{PREFIX}{first.key}_{suffix}"
+    return f"{prefix}{first.key}_{suffix}"
 
 
-def geom_prefix(inst: Instance) -> str:
+def geom_prefix(inst: Instance, prefix: str = PREFIX) -> str:
     """Prefix of every MuJoCo geom name of one instance inside the merged body."""
-    return f"{PREFIX}{inst.key}_"
+    return f"{prefix}{inst.key}_"
 
 
 def mass_inertia(inst: Instance) -> tuple[float, np.ndarray]:
@@ -70,15 +71,15 @@ def mass_inertia(inst: Instance) -> tuple[float, np.ndarray]:
     return m, np.array([side, side, 0.5 * m * r * r])
 
 
-def build_item(category: str):
+def build_item(category: str, prefix: str = PREFIX):
     """The merged robosuite object of a category (free joint; first instance's body)."""
     from rover.sim.kitchen.objects import build_object
 
     members = instances(category)
-    host = build_object(members[0], prefix=PREFIX)
+    host = build_object(members[0], prefix=prefix)
     body = host.get_obj()
     for inst in members[1:]:
-        other = build_object(inst, prefix=PREFIX)
+        other = build_object(inst, prefix=prefix)
         for geom in other.get_obj().findall("geom"):
             body.append(geom)
         for child in other.asset:
@@ -96,10 +97,10 @@ class ItemGeoms:
     group: dict[int, int]
 
     @classmethod
-    def of(cls, model, category: str) -> ItemGeoms:
+    def of(cls, model, category: str, prefix: str = PREFIX) -> ItemGeoms:
         names = [model.geom(g).name for g in range(model.ngeom)]
         ids = {
-            inst.name: [g for g, n in enumerate(names) if n.startswith(geom_prefix(inst))]
+            inst.name: [g for g, n in enumerate(names) if n.startswith(geom_prefix(inst, prefix))]
             for inst in instances(category)
         }
         every = [g for gs in ids.values() for g in gs]

@@ -62,6 +62,11 @@ PARAPHRASES: dict[str, list[str]] = {
         "Switch the faucet off with its lever.",
         "Turn off the sink faucet.",
     ],
+    "ArrangeVegetables": [
+        "Put both vegetables from the counter onto the cutting board.",
+        "Move the two vegetables onto the cutting board, one after the other.",
+        "Set the vegetables lying on the counter on the cutting board.",
+    ],
     "TurnSinkSpout": [
         "Swivel the faucet spout to the left.",
         "Swing the sink's spout over to the left side.",
