@@ -94,10 +94,14 @@ def test_place_window_ends_before_the_release():
     assert cut_window(lv, COMPS, m, 30) == (20, 29)
 
 
-def test_contact_level_cuts_at_the_contact_when_the_hold_starts_with_it():
+def test_contact_level_skips_a_demo_whose_hold_starts_with_the_contact():
+    """No step of such a demo is touched-not-held: cutting at the contact cut into the
+    hold (a grasp and a drop in a "contact" video); another demo is used instead."""
     m = ExpertMarks(steps=(2, 6, 9, 12, 20, 31), holds={"can": ((6, 30),)}, length=40)
     lv = next(lv for lv in get_task("PickPlaceCan").levels if lv.level == 3)
-    assert cut_window(lv, COMPS, m, 30) == (6, 6)
+    assert cut_window(lv, COMPS, m, 30) is None
+    later = ExpertMarks(steps=(2, 6, 9, 12, 20, 31), holds={"can": ((8, 30),)}, length=40)
+    assert cut_window(lv, COMPS, later, 30) == (6, 7)
 
 
 def test_snap_position_puts_a_frame_on_the_cut():
@@ -194,12 +198,16 @@ def test_progress_bands_rise_with_the_level():
     app, con = p["approach:can"], p["contact:can"]
     assert bands[1] == (0.0, 1.0) and bands[7] is None
     assert bands[2] == pytest.approx((app - BAND_UNDO, (app + con) / 2))
-    assert bands[3] == pytest.approx(((app + con) / 2, con - BAND_GAP))
-    assert bands[4] == pytest.approx((con - BAND_GAP, 1.0))  # it lets go: back to the contact
+    # touched, the open hand backing off: from under the approach up to the contact
+    assert bands[3] == pytest.approx((app - BAND_UNDO / 2, con))
+    # set back down, the open hand at it: above the approach-contact midpoint, not carried
+    assert bands[4] == pytest.approx(((app + con) / 2, p["pick_up:can"] - BAND_GAP))
     assert bands[5] == pytest.approx((p["carry:can"] - BAND_UNDO, 1.0))
-    # each level's ceiling is at most the next level's floor (L2 | L3 | L4 never overlap)
-    for lo_lv, hi_lv in ((2, 3), (3, 4)):
-        assert bands[lo_lv][1] <= bands[hi_lv][0] + 1e-9
+    # floors and ceilings rise with the level (the pick-and-place endings order the
+    # levels' final states; the bands only keep each one near where it belongs)
+    for lo_lv, hi_lv in ((2, 3), (3, 4), (4, 5)):
+        assert bands[lo_lv][0] < bands[hi_lv][0]
+        assert bands[lo_lv][1] <= bands[hi_lv][1]
     gone = ExpertMarks(steps=(10, None, None, None, None, None), holds={}, length=90)
     assert progress_band(spec.levels[2], COMPS, gone, expert) is None
 
