@@ -65,7 +65,7 @@ PARAPHRASES: dict[str, list[str]] = {
     "ArrangeVegetables": [
         "Put both vegetables from the counter onto the cutting board.",
         "Move the two vegetables onto the cutting board, one after the other.",
-        "Set the vegetables lying on the counter on the cutting board.",
+        "Take the vegetables from the counter and set them on the cutting board.",
     ],
     "TurnSinkSpout": [
         "Swivel the faucet spout to the left.",
