@@ -100,7 +100,7 @@ PICK_PLACE_ENDINGS: dict[str, dict] = {
         "terminal_settle": (10, 16),
         "terminal_w": (8, 12),
         "scale": (0.0, 0.05),
-        "terminal_drift": (0.0, 0.0, -1.0),
+        "terminal_drift": (0.0, 0.0, -0.4),
     },
 }
 
