@@ -12,6 +12,7 @@ seeded by (seed, task, index), so a rerun or a resumed run reproduces the same e
 from __future__ import annotations
 
 import atexit
+import gc
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -114,6 +115,32 @@ class _TaskState:
 _SIMS: dict[str, object] = {}  # task -> SimEnv (building one takes about a second)
 _RENDERERS: dict[tuple[str, int], object] = {}
 _CACHE: dict[tuple[str, int, str], _TaskState] = {}
+KEEP_TASKS = 2  # tasks whose simulator, renderer and demos a worker keeps at once
+_RECENT: list[str] = []  # this process's tasks, most recently used last
+
+
+def _evict_all_but_recent(name: str) -> None:
+    """Drop the per-process state of tasks this worker has moved past.
+
+    Work items come grouped by task, so a worker rarely returns to a task; keeping every
+    task's simulator, EGL renderer and demos made one worker of a 17-task kitchen run grow
+    to 11 GB and be killed by the kernel (and a pool whose worker is killed waits forever).
+    Rebuilding a dropped task costs about a second; outputs do not depend on the caches.
+    """
+    from rover.sim.attempt import _MARKS
+
+    if name in _RECENT:
+        _RECENT.remove(name)
+    _RECENT.append(name)
+    for old in _RECENT[:-KEEP_TASKS]:
+        _RECENT.remove(old)
+        _SIMS.pop(old, None)
+        _MARKS.pop(old, None)
+        for key in [k for k in _RENDERERS if k[0] == old]:
+            _RENDERERS.pop(key).close()
+        for key in [k for k in _CACHE if k[0] == old]:
+            del _CACHE[key]
+        gc.collect()  # robosuite's envs hold reference cycles: free them now
 
 
 def _close_renderers() -> None:
@@ -142,6 +169,7 @@ def _task_state(spec: TaskSpec, cfg: GenerateConfig, demo_dir: Path) -> _TaskSta
 
     path = demo_dir / f"{spec.name}.hdf5"
     key = (spec.name, cfg.size, str(path.resolve()))
+    _evict_all_but_recent(spec.name)
     if key in _CACHE:
         return _CACHE[key]
     sim = _sim_for(spec)
@@ -187,6 +215,7 @@ def make_demos(task: str, cfg: GenerateConfig, demo_dir: Path) -> Path:
         recs = read_demos(src, limit=cfg.demos)
         write_demos(path, spec.env_name, spec.env_kwargs, recs)
         return path
+    _evict_all_but_recent(task)
     sim = _sim_for(spec)
     recs = []
     seed = cfg.seed * 100_003 + 1
