@@ -3,6 +3,7 @@ to build), shared by every sim test file."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 
@@ -21,3 +22,28 @@ def sim_env():
         return cache[task]
 
     return _get
+
+
+class ActionRecorder:
+    """A stand-in simulator for plan tests: records the actions a plan sends (no physics)."""
+
+    def __init__(self, dims: int) -> None:
+        self.action_low = -np.ones(dims)
+        self.action_high = np.ones(dims)
+        self.s = np.zeros(3)
+        self.actions: list[np.ndarray] = []
+
+    def get_state(self):
+        return self.s.copy()
+
+    def set_state(self, s):
+        self.s = np.asarray(s, dtype=float).copy()
+
+    def step(self, a):
+        self.actions.append(np.asarray(a).copy())
+
+
+@pytest.fixture
+def action_recorder():
+    """``action_recorder(dims)``: a fresh `ActionRecorder` with that many action channels."""
+    return ActionRecorder

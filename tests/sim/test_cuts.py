@@ -146,27 +146,11 @@ def test_plan_leaves_the_expert_at_the_given_cut():
     assert plan.segments[-2] == ExpertSegment(0, 73)
 
 
-class _Recorder:
-    action_low = -np.ones(4)
-    action_high = np.ones(4)
-
-    def __init__(self) -> None:
-        self.s = np.zeros(3)
-        self.actions: list[np.ndarray] = []
-
-    def get_state(self):
-        return self.s.copy()
-
-    def set_state(self, s):
-        self.s = np.asarray(s, dtype=float).copy()
-
-    def step(self, a):
-        self.actions.append(np.asarray(a).copy())
 
 
 @pytest.mark.parametrize("grip", [-1.0, 1.0, None])
-def test_terminal_grip_holds_the_gripper_channel(grip):
-    sim = _Recorder()
+def test_terminal_grip_holds_the_gripper_channel(action_recorder, grip):
+    sim = action_recorder(4)
     seg = RandomSegment(q=0, w=30, scale=1.0, hold=1, grip=grip)
     plan = TrajectoryPlan(2, ((0, 1),), (seg,), 1, True)
     execute_plan(sim, np.zeros((2, 3)), np.zeros((1, 4)), plan, np.random.default_rng(0))

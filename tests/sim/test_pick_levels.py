@@ -11,28 +11,8 @@ from rover.sim.tasks import get_task
 from rover.sim.tasks._common import PICK_PLACE_ENDINGS
 
 
-class _Recorder:
-    """Records the actions a plan sends (no physics)."""
-
-    action_low = -np.ones(7)
-    action_high = np.ones(7)
-
-    def __init__(self) -> None:
-        self.s = np.zeros(3)
-        self.actions: list[np.ndarray] = []
-
-    def get_state(self):
-        return self.s.copy()
-
-    def set_state(self, s):
-        self.s = np.asarray(s, dtype=float).copy()
-
-    def step(self, a):
-        self.actions.append(np.asarray(a).copy())
-
-
-def test_settle_lowers_in_the_grasp_then_opens_and_stops_the_drift():
-    sim = _Recorder()
+def test_settle_lowers_in_the_grasp_then_opens_and_stops_the_drift(action_recorder):
+    sim = action_recorder(7)
     seg = RandomSegment(q=0, w=20, scale=0.5, hold=1, grip=-1.0, drift=(0, 0, -1.0), settle=8)
     plan = TrajectoryPlan(2, ((0, 1),), (seg,), 4, True)
     execute_plan(sim, np.zeros((2, 3)), np.zeros((1, 7)), plan, np.random.default_rng(0))
@@ -46,8 +26,8 @@ def test_settle_lowers_in_the_grasp_then_opens_and_stops_the_drift():
     assert abs(acts[8:, 2].mean()) < 0.3 and acts[8:, :6].std() > 0.1
 
 
-def test_a_segment_without_settle_keeps_the_drift_throughout():
-    sim = _Recorder()
+def test_a_segment_without_settle_keeps_the_drift_throughout(action_recorder):
+    sim = action_recorder(7)
     seg = RandomSegment(q=0, w=12, scale=0.1, hold=1, grip=-1.0, drift=(0, 0, 0.3))
     plan = TrajectoryPlan(2, ((0, 1),), (seg,), 3, True)
     execute_plan(sim, np.zeros((2, 3)), np.zeros((1, 7)), plan, np.random.default_rng(0))
