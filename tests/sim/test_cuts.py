@@ -146,8 +146,6 @@ def test_plan_leaves_the_expert_at_the_given_cut():
     assert plan.segments[-2] == ExpertSegment(0, 73)
 
 
-
-
 @pytest.mark.parametrize("grip", [-1.0, 1.0, None])
 def test_terminal_grip_holds_the_gripper_channel(action_recorder, grip):
     sim = action_recorder(4)
