@@ -11,7 +11,11 @@ since the previous control step), at any height. A hold, once begun, survives a 
 where one finger loses contact for a moment, as long as the object still moves with the
 hand. Events follow from holds: ``grasp`` is a hold beginning, ``pick_up`` a held object
 first lifted off its start, and a hold's end is a ``place`` when the object is then
-resting in or on its goal region and a ``drop`` otherwise (it falls).
+resting in or on its goal region and a ``drop`` otherwise (it falls). An object let go a
+few centimetres above its goal is still falling at the frame the hold ends (a cereal box
+reads "on the table" for the one frame it passes the bin's rim height): the place is the
+frame it lands in the goal, if that is within `LANDING_FRAMES` frames and before any new
+hold.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from rover.episode import Event, FrameFacts, ObjectFacts, QAItem
 from rover.sim import articulation
 from rover.sim.env import SimEnv
 from rover.sim.tasks.base import TaskSpec
+from rover.sim.validate import LANDING_FRAMES
 
 CLOSED_BELOW = 0.9  # opening fraction under which the gripper reads as closed
 OPEN_START = 0.05  # door opening fraction at which "start opening" happens
@@ -246,14 +251,19 @@ def hold_spans(facts: list[FrameFacts], obj: str) -> list[tuple[int, int | None]
 def releases(spec: TaskSpec, facts: list[FrameFacts], obj: str) -> list[tuple[str, int]]:
     """("place" | "drop", frame) for each hold of `obj` that ends, in order.
 
-    A hold ends at the first frame the object is not held; it is a place when the object
-    rests in or on its goal region there, else a drop.
+    A hold ends at the first frame the object is not held; it is a place (at the frame
+    it lands) when the object rests in or on its goal region there or within
+    `LANDING_FRAMES` frames after, before any new hold; else a drop, at the hold's end.
     """
     out: list[tuple[str, int]] = []
-    for _, end in hold_spans(facts, obj):
+    spans = hold_spans(facts, obj)
+    for i, (_, end) in enumerate(spans):
         if end is None:
             continue
-        out.append(("place" if target_reached(spec, obj, facts[end]) else "drop", end))
+        regrip = spans[i + 1][0] if i + 1 < len(spans) else len(facts)
+        last = min(end + LANDING_FRAMES, regrip - 1)
+        land = next((t for t in range(end, last + 1) if target_reached(spec, obj, facts[t])), None)
+        out.append(("drop", end) if land is None else ("place", land))
     return out
 
 

@@ -51,6 +51,10 @@ def _opening(f: FrameFacts, obj: str) -> bool:
     return obj not in f.articulations or f.articulations[obj] > 0.0
 
 
+# frames a released object may take to land in its goal: its place is that frame (read by
+# `rover.sim.facts.releases` too; kept here because the audit must not import MuJoCo)
+LANDING_FRAMES = 2
+
 # events that mark a hold beginning (True) or ending (False): the frame before must differ
 HOLD_CHANGE = {"grasp": True, "drop": False, "place": False}
 
@@ -93,6 +97,9 @@ def event_problems(event: Event, facts: list[FrameFacts]) -> list[str]:
         return [f"event {event.name} {event.object!r} at frame 0 ends a hold no frame shows"]
     if begins is not None and event.frame > 0:
         before = _held(facts[event.frame - 1], event.object)
+        if event.name == "place" and not before:  # it may land a few frames after the hold
+            lo = max(event.frame - 1 - LANDING_FRAMES, 0)
+            before = any(_held(f, event.object) for f in facts[lo : event.frame - 1])
         if before == begins:
             state = "already held" if begins else "not held"
             return [
@@ -128,6 +135,9 @@ def validate_episode(episode: Episode, max_level: int | None = None) -> list[str
                 f"highest level {max_level} ends at progress {prog[-1]:.3f} "
                 f"< {HIGHEST_LEVEL_MIN_END}"
             )
+        drops = [e for e in truth.events if e.name == "drop" and e.frame is not None]
+        for e in drops:  # a successful video that "drops" would score a correct model wrong
+            out.append(f"highest level {max_level} shows a drop of {e.object!r} at frame {e.frame}")
     if truth.state_type is not None:
         if len(truth.state_type) != n:
             out.append(f"{len(truth.state_type)} state types for {n} frames")
