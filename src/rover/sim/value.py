@@ -325,6 +325,9 @@ def _reach(
     return q, sub_idx, done
 
 
+LANDING_STEPS = 10  # control steps (0.5 s at 20 Hz) a released object may fall to its goal
+
+
 def _undo(
     tracks: Tracks, q: np.ndarray, sub_idx: np.ndarray, subtasks, bounds
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -333,7 +336,10 @@ def _undo(
     Subtask i is undone at a step of a later subtask when its achievement no longer
     stands (`Tracks.kept`) and no subtask after it stands either (a can resting in its
     bin keeps the grasp subtask done although nothing holds it any more). Such a step
-    gets subtask i's value of its state, measured against i's last expert step.
+    gets subtask i's value of its state, measured against i's last expert step. A step
+    from which a later subtask stands again within `LANDING_STEPS` (an object let go just
+    above its goal, in the air for a few steps) is in flight to it, not undone: valued as
+    undone, the cereal box falling into its bin read 0.00 for one frame between 0.98 and 1.
     """
     q, sub_idx = q.copy(), sub_idx.copy()
     if not tracks.kept:
@@ -345,7 +351,8 @@ def _undo(
     for r in range(len(q)):
         k = int(sub_idx[r])
         for i in range(k):
-            if not stand[r, i] and not stand[r, i + 1 : n_sub].any():
+            landing = stand[r : r + LANDING_STEPS + 1, i + 1 : n_sub].any()
+            if not stand[r, i] and not stand[r, i + 1 : n_sub].any() and not landing:
                 sub_idx[r], q[r] = i, bounds[i][1]
                 break
     return q, sub_idx
