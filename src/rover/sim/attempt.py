@@ -260,6 +260,12 @@ def make_attempts(
                 )
             if level.level == top and prog[-1] < HIGHEST_MIN_END:
                 problems.append(f"top level ends at progress {prog[-1]:.2f} < {HIGHEST_MIN_END}")
+            if level.level == top:  # the audit's rule: a successful video never "drops"
+                problems += [
+                    f"top level shows a drop of {e.object!r} at frame {e.frame}"
+                    for e in events
+                    if e.name == "drop" and e.frame is not None
+                ]
             yield Attempt(tries, d, roll, prog, pos, facts, events, problems)
             if roll.recovery_gap > RECOVERY_GAP or tries >= MAX_TRIES:
                 break  # the prefix itself is at fault: plan again
