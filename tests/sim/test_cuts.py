@@ -7,7 +7,14 @@ import pytest
 
 from rover.episode import FrameFacts, ObjectFacts
 from rover.sim.audit import facts_changed
-from rover.sim.cuts import CARRY_WINDOW_FRAMES, ExpertMarks, cut_window, draw_cut, expert_marks
+from rover.sim.cuts import (
+    CARRY_WINDOW_FRAMES,
+    ExpertMarks,
+    cut_window,
+    draw_cut,
+    expert_marks,
+    held_contact_window,
+)
 from rover.sim.levels import ENDINGS_BY_KIND, LevelSpec, by_milestone, component_kind
 from rover.sim.perturb import (
     ExpertSegment,
@@ -64,6 +71,19 @@ def test_expert_marks_find_each_component_first_step(marks):
     assert marks.steps[5] == 30
     assert marks.holds["can"] == ((14, 30),)
     assert marks.length == 40
+
+
+def test_a_hold_that_starts_with_the_contact_is_cut_at_the_contact(marks):
+    """Both fingers closing on the object at the very step of the first touch leave no
+    touched-not-held stretch: L3 is then cut at that step (and only L3)."""
+    from dataclasses import replace
+
+    levels = {lv.level: lv for lv in get_task("PickPlaceCan").levels}
+    assert held_contact_window(levels[3], COMPS, marks) is None  # the hold starts at 14 > 10
+    square = replace(marks, steps=(6, 14, 16, 19, 24, 30))  # contact and hold both at 14
+    assert cut_window(levels[3], COMPS, square, 30) is None
+    assert held_contact_window(levels[3], COMPS, square) == (14, 14)
+    assert all(held_contact_window(levels[k], COMPS, square) is None for k in (1, 2, 4, 5, 6, 7))
 
 
 def test_cut_window_per_kind(marks):

@@ -96,6 +96,28 @@ def test_opening_the_hand_in_the_air_is_a_drop(lift):
     assert all(event_problems(e, facts) == [] for e in events)
 
 
+def test_letting_go_of_an_object_never_moved_is_neither_drop_nor_place(lift):
+    """Fingers closed on the cube at the table (a hold, no lift), then opened: the cube
+    never left where it stood, so the release is no drop (it did not fall), no place."""
+    from rover.sim.facts import detect_events, facts_for_states
+
+    sim, demo = lift
+    t = _first_both(sim, demo.states, "cube")
+    before, grasped = demo.states[t - 1], demo.states[t + 1]
+    states = np.stack([before, grasped, _fingers(sim, grasped, 0.04)])
+    prev = np.stack([before, demo.states[t], grasped])
+    facts = facts_for_states(sim, states, prev)
+    assert facts[1].holding == "cube" and not facts[1].objects["cube"].lifted
+    assert facts[2].holding is None
+    ev = {e.name: e.frame for e in detect_events(sim.spec, facts)}
+    assert ev["grasp"] == 1 and ev["drop"] is None and ev["pick_up"] is None
+    # the same release with the cube 3 cm off where it stood: it was taken somewhere
+    moved = states.copy()
+    moved[2, _free_qpos(sim, "cube_main")] += 0.03
+    facts = facts_for_states(sim, moved, prev)
+    assert {e.name: e.frame for e in detect_events(sim.spec, facts)}["drop"] == 2
+
+
 @pytest.fixture(scope="module")
 def can(sim_env):
     from rover.sim.experts import run_expert

@@ -145,10 +145,9 @@ def make_attempts(
     """
     from dataclasses import replace
 
-    from rover.sim.cuts import cut_window, draw_cut, progress_band
+    from rover.sim.cuts import cut_window, draw_cut, held_contact_window, progress_band
     from rover.sim.facts import detect_events, facts_for_states
     from rover.sim.perturb import (
-        RandomSegment,
         TrajectoryPlan,
         bounds_from_ends,
         execute_plan,
@@ -183,11 +182,15 @@ def make_attempts(
                 goal_end=int(ends[-1]), form=form,  # type: ignore[arg-type]
             )  # fmt: skip
         window = cut_window(level, spec.milestones, marks[key], frames)
+        held = None
+        if window is None:  # a demo whose hold starts with its contact
+            window = held = held_contact_window(level, spec.milestones, marks[key])
         band = None
         if window is not None:  # cut by milestone: the level's own band
             band = progress_band(level, spec.milestones, marks[key], marks[pkey])
-            window = within_band(window, marks[pkey], band)
-            window = _touching(sim, spec, level, states, window, marks, key)
+            if held is None:
+                window = within_band(window, marks[pkey], band)
+                window = _touching(sim, spec, level, states, window, marks, key)
         if band is None:  # no milestone marks: the level below's subtask fraction
             band = (_floor(below, marks[pkey], bounds), 1.0)
         cut = draw_cut(window, level, rng) if window is not None else None
@@ -214,15 +217,12 @@ def make_attempts(
                 seg = terminal
                 if e:  # a fresh ending, each a little gentler than the last
                     w = int(rng.integers(level.terminal_w[0], level.terminal_w[1] + 1))
-                    seg = RandomSegment(
-                        seg.q,
-                        w + seg.settle,
-                        seg.scale * 0.8**e,
-                        min(seg.hold, w),
-                        0,
-                        seg.grip,
-                        seg.drift,
-                        seg.settle,
+                    seg = replace(
+                        seg,
+                        w=w + seg.settle,
+                        scale=seg.scale * 0.8**e,
+                        hold=min(seg.hold, w),
+                        depth=0,
                     )
                 tail_plan = TrajectoryPlan(
                     plan.expert_len, plan.subtask_bounds, (seg,), plan.level, True
@@ -341,13 +341,14 @@ def _demo_key(d: int, states: np.ndarray) -> tuple[int, int, int]:
 
 
 def _usable_demos(sim, spec: TaskSpec, level: LevelSpec, demos: list, marks: dict, frames: int):
-    """The demos in which a level can be cut by milestone (all of them when none can, or
+    """The demos in which a level can be cut by milestone (else those it can be cut at
+    a held contact, `rover.sim.cuts.held_contact_window`; all of them when neither, or
     the level does not cut by milestone): a Stack demo that grasps the red cube already
     within reach of the green one shows "over the target" before "carry", so its L5
     stretch is empty."""
-    from rover.sim.cuts import cut_window
+    from rover.sim.cuts import cut_window, held_contact_window
 
-    ok = []
+    ok, held = [], []
     for d, (states, _, _, demo_seed) in enumerate(demos):
         key = _demo_key(d, states)
         if key not in marks:
@@ -356,7 +357,9 @@ def _usable_demos(sim, spec: TaskSpec, level: LevelSpec, demos: list, marks: dic
             marks[key] = demo_marks(sim, spec, states)
         if level.milestone_cut is None or cut_window(level, spec.milestones, marks[key], frames):
             ok.append(d)
-    return ok or list(range(len(demos)))
+        elif held_contact_window(level, spec.milestones, marks[key]):
+            held.append(d)
+    return ok or held or list(range(len(demos)))
 
 
 def snap_position(pos: list[int], step: int) -> list[int]:

@@ -139,6 +139,33 @@ def cut_window(
     return int(lo), int(hi)
 
 
+def held_contact_window(
+    level: LevelSpec, components: Sequence[str], marks: ExpertMarks
+) -> tuple[int, int] | None:
+    """Where a "touched, not picked up" video leaves a demo whose hold starts with its contact.
+
+    When both fingers close on the object at the very step of the first touch (a milk
+    carton squeezed square-on), the demo has no touched-not-held stretch and
+    `cut_window` gives none. The video then leaves the expert at that step: the frame
+    shows the fingers on the object, and the level's ending opens them and backs the
+    hand off, without lifting it. (A hold that never lifts the object ends in neither a
+    drop nor a place: `rover.sim.facts.releases`.) None for any other case.
+    """
+    L = level.level
+    if level.completes or level.milestone_cut is None or L - 1 >= len(components):
+        return None
+    nxt = components[L - 1]
+    if component_kind(nxt) != "pick_up":  # (a hold would show a "grasp" component)
+        return None
+    lo = _all_shown(marks, L - 1)
+    if lo is None or lo == 0:
+        return None
+    hold = _hold_after(marks, nxt.partition(":")[2], lo)
+    if hold is None or hold[0] != lo:
+        return None
+    return int(lo), int(lo)
+
+
 def draw_cut(window: tuple[int, int], level: LevelSpec, rng: np.random.Generator) -> int:
     """The expert step the video leaves at: ``level.milestone_cut`` of the window."""
     lo, hi = window

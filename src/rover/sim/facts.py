@@ -33,6 +33,7 @@ OPEN_START = 0.05  # door opening fraction at which "start opening" happens
 OPEN_FINISH = 0.9  # ... and "completely open"
 MOVES_WITH = 0.005  # m: the most a held object may shift in the hand's frame per step
 FULLY_OPEN = 0.97  # opening fraction above which fingers touching both sides only brush it
+STOOD = 0.015  # m: a held object that moves less than this was never taken anywhere
 
 
 def grip_point(spec: TaskSpec, obj: str) -> str:
@@ -248,17 +249,37 @@ def hold_spans(facts: list[FrameFacts], obj: str) -> list[tuple[int, int | None]
     return spans
 
 
+def _stood(facts: list[FrameFacts], obj: str, start: int, end: int) -> bool:
+    """Whether `obj` stays within `STOOD` of where it stood the frame before a hold took
+    it, unlifted, up to the frame after the hold."""
+    first = facts[max(start - 1, 0)].objects.get(obj)
+    if first is None or first.position is None:
+        return False
+    p0 = np.asarray(first.position)
+    for f in facts[start : end + 1]:
+        o = f.objects.get(obj)
+        if o is None or o.position is None or o.lifted:
+            return False
+        if np.linalg.norm(np.asarray(o.position) - p0) > STOOD:
+            return False
+    return True
+
+
 def releases(spec: TaskSpec, facts: list[FrameFacts], obj: str) -> list[tuple[str, int]]:
     """("place" | "drop", frame) for each hold of `obj` that ends, in order.
 
     A hold ends at the first frame the object is not held; it is a place (at the frame
     it lands) when the object rests in or on its goal region there or within
     `LANDING_FRAMES` frames after, before any new hold; else a drop, at the hold's end.
+    A hold in which the object never moves (fingers closed on it, then opened) is
+    neither: it was let go where it stood, and did not fall (`STOOD`).
     """
     out: list[tuple[str, int]] = []
     spans = hold_spans(facts, obj)
-    for i, (_, end) in enumerate(spans):
+    for i, (start, end) in enumerate(spans):
         if end is None:
+            continue
+        if _stood(facts, obj, start, end):
             continue
         regrip = spans[i + 1][0] if i + 1 < len(spans) else len(facts)
         last = min(end + LANDING_FRAMES, regrip - 1)
