@@ -1,18 +1,21 @@
-"""Can the scripted Panda hold its hand level (pointing forward) at kitchen-fixture heights?
+"""Can the scripted Panda hold its hand level (pointing forward) where the forward grasp works?
 
-Usage: python benchmarks/forward_reach.py [--steps 150]
+Usage: python benchmarks/forward_reach.py [--steps 150] [--seed 0]
 
-The cabinet, microwave and coffee-machine pick-and-place tasks need a hand that points
-horizontally into the fixture (`rover.sim.experts.Scripted.pitch = -pi/2`). This drives
-robosuite's OSC_POSE controller, as the experts do, toward level-hand targets at the
-heights those tasks grasp at (an item on the counter, the microwave cavity, the coffee
-drip tray, higher up) from two start poses, and prints how close it gets:
+The microwave (and later cabinet and coffee-machine) pick-and-place tasks take their
+item with a hand that points horizontally into the fixture
+(`rover.sim.experts.Scripted.pitch = -pi/2`). This drives robosuite's OSC_POSE
+controller, as the experts do, toward level-hand targets in the scene of
+kitchen.PickPlaceCounterToMicrowave (seed `--seed`: the item's counter spot, the
+microwave's mouth and cavity, higher over the counter) from two start poses, and prints
+how close it gets:
 
 * ``default``: robosuite's Panda start pose (hand down, wrist joint 6 at 2.94 rad);
-* ``flipped wrist``: joint 5 turned near its -2.9 rad limit and the hand already level
-  at (-0.2, 0, 0.95), found here by damped least squares from a seeded guess.
+* ``ready``: the forward grasp's level-hand start (`rover.sim.kitchen.forward_grasp.READY_Q`,
+  hand at (-0.25, 0.05, 0.92)), which the forward-grasp tasks start in.
 
-A row reads: the target, the final position error (cm) and orientation error (deg) after
+Each target is driven to from a fresh reset, with the item moved out of the way. A row
+reads: the target, the final position error (cm) and orientation error (deg) after
 `--steps` control steps, and the joints that ended within 0.05 rad of a limit.
 """
 
@@ -23,49 +26,17 @@ import os
 
 import numpy as np
 
-TARGETS = {  # name -> world point of the grip site (counter top at z = 0.80)
-    "counter item": (-0.10, 0.24, 0.84),
-    "microwave cavity": (0.05, -0.13, 0.87),
-    "coffee drip tray": (0.06, 0.00, 0.87),
-    "counter +10 cm": (-0.10, 0.00, 0.90),
-    "counter +25 cm": (-0.10, 0.00, 1.05),
-    "counter +45 cm": (-0.10, 0.00, 1.25),
-}
 PITCH = -np.pi / 2
-FLIP_AT = np.array([-0.2, 0.0, 0.95])
 
 
-def _solve(sim, q: np.ndarray, target: np.ndarray, want: np.ndarray) -> np.ndarray:
-    """Damped least-squares IK of the grip site (position and orientation), joint-limited."""
-    import mujoco
-    from scipy.spatial.transform import Rotation
-
-    m, d = sim.model, sim.data
-    robot = sim.env.robots[0]
-    qi, vi = np.array(robot._ref_joint_pos_indexes), np.array(robot._ref_joint_vel_indexes)
-    lim = m.jnt_range[np.array(robot._ref_joint_indexes)]
-    jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
-    for _ in range(800):
-        d.qpos[qi] = q
-        mujoco.mj_forward(m, d)
-        err = np.concatenate(
-            [
-                target - d.site_xpos[sim._eef_site],
-                Rotation.from_matrix(want @ d.site_xmat[sim._eef_site].reshape(3, 3).T).as_rotvec(),
-            ]
-        )
-        mujoco.mj_jacSite(m, d, jp, jr, sim._eef_site)
-        jac = np.vstack([jp[:, vi], jr[:, vi]])
-        step = jac.T @ np.linalg.solve(jac @ jac.T + 1e-2 * np.eye(6), err)
-        q = np.clip(q + 0.2 * step, lim[:, 0] + 0.05, lim[:, 1] - 0.05)
-    return q
-
-
-def _start(sim, q: np.ndarray) -> None:
+def _start(sim, q: np.ndarray, seed: int) -> None:
+    """The scene of `seed`, the item set aside, the arm at `q` with the OSC posture there."""
     import mujoco
 
     robot = sim.env.robots[0]
-    sim.reset(0)
+    sim.reset(seed)
+    a, _ = sim.env.item_qpos_addr
+    sim.data.qpos[a : a + 3] = [-0.3, -0.9, 0.9]  # off the counter's working stretch
     sim.data.qpos[np.array(robot._ref_joint_pos_indexes)] = q
     sim.data.qvel[np.array(robot._ref_joint_vel_indexes)] = 0.0
     mujoco.mj_forward(sim.model, sim.data)
@@ -78,44 +49,54 @@ def main() -> None:
     os.environ.setdefault("MUJOCO_GL", "egl")
     from rich.console import Console
     from rich.table import Table
-    from scipy.spatial.transform import Rotation
 
     from rover.sim.env import SimEnv
     from rover.sim.experts import Scripted
+    from rover.sim.kitchen.forward_grasp import HAND_DOWN, READY_Q
     from rover.sim.motions import OPEN
     from rover.sim.tasks import get_task
 
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--steps", type=int, default=150)
+    ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     if args.steps < 1:
         ap.error("--steps must be at least 1")
-    sim = SimEnv(get_task("kitchen.PickPlaceCounterToSink"))
-    sim.reset(0)
-    robot = sim.env.robots[0]
+    sim = SimEnv(get_task("kitchen.PickPlaceCounterToMicrowave"))
+    sim.reset(args.seed)
+    env = sim.env
+    robot = env.robots[0]
     qi = np.array(robot._ref_joint_pos_indexes)
     lim = sim.model.jnt_range[np.array(robot._ref_joint_indexes)]
-    down = sim.data.site_xmat[sim._eef_site].reshape(3, 3).copy()
-    level = Rotation.from_euler("yz", [PITCH, 0.0]).as_matrix() @ down
-    default = sim.data.qpos[qi].copy()
-    guess = default.copy()
-    guess[4], guess[5], guess[6] = -2.8, 2 * np.pi - (default[1] - default[3]), default[6] - np.pi
-    flipped = _solve(sim, _solve(sim, guess, sim.point("eef"), down), FLIP_AT, level)
-    poses = {"default": default, "flipped wrist": flipped}
+    down = np.array(HAND_DOWN)
+    place = env.scene.layout["Microwave"]
+    ahead = np.array([np.cos(place.yaw), np.sin(place.yaw), 0.0])
+    cavity = sim.data.site_xpos[sim.model.site("Microwave_interior").id].copy()
+    cavity[2] = 0.80 + 0.01 + 0.045
+    spot = sim.point(sim.spec.objects[0].name)
+    targets = {
+        "counter spot": spot,
+        "microwave mouth": cavity - 0.2 * ahead,
+        "microwave cavity": cavity,
+        "counter +25 cm": np.array([-0.10, 0.0, 1.05]),
+        "counter +45 cm": np.array([-0.10, 0.0, 1.25]),
+    }
+    poses = {"default": np.array(robot.robot_model.init_qpos), "ready": np.array(READY_Q)}
+    yaw = float(place.yaw)  # the expert points the hand along the microwave's depth
 
     table = Table(title=f"Level hand (pitch {np.degrees(PITCH):.0f} deg), {args.steps} OSC steps")
     for col in ("start pose", "target", "z", "pos err cm", "rot err deg", "joints at a limit"):
         table.add_column(col)
     for pose, q in poses.items():
-        for name, point in TARGETS.items():
-            _start(sim, q)
+        for name, point in targets.items():
+            _start(sim, q, args.seed)
             script = Scripted(sim)
             script.down, script.pitch = down, PITCH
-            target = np.array(point)
+            target = np.asarray(point, dtype=np.float64)
             for _ in range(args.steps):
-                sim.step(script.action(target, OPEN, 0.0, 1.0))
+                sim.step(script.action(target, OPEN, yaw, 1.0))
             pos = float(np.linalg.norm(target - sim.point("eef")))
-            rot = float(np.linalg.norm(script.rot_error(0.0)))
+            rot = float(np.linalg.norm(script.rot_error(yaw)))
             q_end = sim.data.qpos[qi]
             stuck = [
                 f"j{k + 1} {q_end[k]:.2f}"
@@ -132,7 +113,7 @@ def main() -> None:
             )
     console = Console(width=120)
     console.print(table)
-    console.print("flipped-wrist start pose (rad): " + " ".join(f"{v:.3f}" for v in flipped))
+    console.print("ready start pose (rad): " + " ".join(f"{v:.3f}" for v in READY_Q))
 
 
 if __name__ == "__main__":

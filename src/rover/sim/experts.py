@@ -18,6 +18,8 @@ from scipy.spatial.transform import Rotation
 from rover.sim.env import SimEnv
 from rover.sim.experts_articulated import SCRIPTS as ARTICULATED_SCRIPTS
 from rover.sim.kitchen.experts import SCRIPTS as KITCHEN_SCRIPTS
+from rover.sim.kitchen.forward_grasp import FORWARD_PITCH, HAND_DOWN
+from rover.sim.kitchen.forward_grasp import SCRIPTS as FORWARD_SCRIPTS
 from rover.sim.motions import (
     CLOSE,
     GRASP_DZ,
@@ -250,6 +252,8 @@ SCRIPTS: dict[str, Callable[[SimEnv], list[Phase | Retry]]] = {
 }
 SCRIPTS.update(ARTICULATED_SCRIPTS)  # drawer, button, knob (rover's own fixtures)
 SCRIPTS.update(KITCHEN_SCRIPTS)  # kitchen dials and hinged parts, either direction
+SCRIPTS.update(FORWARD_SCRIPTS)  # the forward grasp into the microwave, cabinet, coffee slot
+_PITCH = {name: FORWARD_PITCH for name in FORWARD_SCRIPTS}
 
 
 def run_expert(sim: SimEnv, seed: int) -> Demo:
@@ -257,6 +261,9 @@ def run_expert(sim: SimEnv, seed: int) -> Demo:
     sim.reset(seed)
     script = Scripted(sim)
     script.tilt = _TILT.get(sim.spec.expert, 0.0)
+    script.pitch = _PITCH.get(sim.spec.expert, 0.0)
+    if script.pitch:  # the arm starts with the hand level: pitch from the hand-down frame
+        script.down = np.array(HAND_DOWN)
     for item in SCRIPTS[sim.spec.expert](sim):
         if isinstance(item, Retry):
             for _ in range(item.tries):

@@ -28,9 +28,11 @@ from rover.sim.fixtures.base import FixtureEnv, FixtureObject
 from rover.sim.fixtures.button import PRESS_Q
 from rover.sim.fixtures.drawer import OPEN_Q
 from rover.sim.kitchen.fixtures import COUNTER_SIZE, COUNTER_TOP, FIXTURES
+from rover.sim.kitchen.forward_grasp import READY_Q
 from rover.sim.kitchen.items import ItemGeoms, build_item, mass_inertia
 from rover.sim.kitchen.objects import CATALOGUE, build_object, draw_decor, half_height, make_static
 from rover.sim.kitchen.placement import draw_item, item_bottom, item_place
+from rover.sim.kitchen.regions import OPENINGS
 from rover.sim.kitchen.scene import TEXTURES, Scene, draw_scene, draw_style
 
 TEXTURE_DIR = Path(robosuite.__file__).resolve().parent / "models" / "assets" / "textures"
@@ -77,6 +79,9 @@ class RoverKitchen(FixtureEnv):
         item: category of a free item to pick and place ("vegetable"; None: no item).
             The fixture part is then only the fixture's pose (no articulation facts).
         start, goal: the item's start and goal regions (`rover.sim.kitchen.regions`).
+        level_start: start the Panda in the level-hand ready pose of the forward grasp
+            (`rover.sim.kitchen.forward_grasp.READY_Q`); None: when the item's start or
+            goal region lies behind a fixture's opening.
         **kwargs: the usual `ManipulationEnv` arguments.
     """
 
@@ -90,6 +95,7 @@ class RoverKitchen(FixtureEnv):
         item: str | None = None,
         start: str = "counter",
         goal: str = "counter",
+        level_start: bool | None = None,
         **kwargs,
     ) -> None:
         if fixture not in FIXTURES or part not in FIXTURES[fixture].joints:
@@ -99,6 +105,9 @@ class RoverKitchen(FixtureEnv):
         self.part = "" if item else (facts_as or part)
         self.item_category, self.item_start, self.item_goal = item, start, goal
         self.item_geoms: ItemGeoms | None = None
+        if level_start is None:
+            level_start = bool(item) and bool({start, goal} & set(OPENINGS))
+        self.level_start = level_start
         self.joint = FIXTURES[fixture].joints[part]
         self.used = [fixture, *[f for f in also_used if f != fixture]]
         self.scene: Scene | None = None
@@ -120,6 +129,8 @@ class RoverKitchen(FixtureEnv):
     # ---------------------------------------------------------------- model
     def _load_model(self) -> None:
         ManipulationEnv._load_model(self)
+        if self.level_start:  # robosuite's reset puts the arm here, the OSC posture with it
+            self.robots[0].init_qpos = np.array(READY_Q)
         self.table_full_size = COUNTER_SIZE
         self.table_offset = np.array((0.0, 0.0, COUNTER_TOP))
         xpos = self.robots[0].robot_model.base_xpos_offset["table"](COUNTER_SIZE[0])
@@ -332,8 +343,9 @@ class RoverKitchen(FixtureEnv):
 
     def item_instance(self):
         """The catalogue `Instance` this scene's item is."""
-        name = self.scene.item["name"]
-        return next(i for i in CATALOGUE if i.name == name)
+        from rover.sim.kitchen.forward_items import instance_named
+
+        return instance_named(self.scene.item["name"])
 
     def fixture_poses(self) -> dict[str, tuple[np.ndarray, float]]:
         """Fixture name -> (origin, yaw) of every fixture standing on the counter."""

@@ -74,7 +74,7 @@ FIXTURES: dict[str, Fixture] = {
         Fixture(
             "Microwave",
             ASSETS / "microwave.xml",
-            0.17,
+            0.2,
             0.16,
             (0.07, 0.12),
             (-0.2, -0.02),

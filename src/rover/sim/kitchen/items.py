@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rover.sim.kitchen.objects import Instance, instances
+from rover.sim.kitchen.forward_items import item_instances as instances
+from rover.sim.kitchen.objects import Instance
 
 PREFIX = "item_"
 HIDDEN_GROUP = 3  # render group of switched-off geoms (the renderer shows groups 0-2 only)

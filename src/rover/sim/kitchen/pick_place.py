@@ -19,6 +19,7 @@ the questions, which stay fixed per task while the instance changes with the see
 from __future__ import annotations
 
 from rover.sim.kitchen.items import host_body
+from rover.sim.kitchen.regions import OPENINGS
 from rover.sim.tasks._common import pick_place_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, TaskSpec
 
@@ -30,11 +31,19 @@ GOAL_POINT = {
     "sink": ("Sink_basin", (-0.05, 0.0, 0.0)),
     "stove": ("Stove_burner", (0.0, 0.0, 0.0)),
     "counter": ("kitchen_counter_goal", (0.0, 0.0, 0.0)),
+    "microwave": ("Microwave_interior", (0.0, 0.0, 0.0)),
+    "coffee machine": ("Coffee_slot", (0.0, 0.0, 0.0)),
 }
 # how the instruction names a region as a start ("from ...") and as a goal
 FROM = {"sink": "the sink", "stove": "the stove", "counter": "the counter"}
 TO = {"sink": "in the sink", "stove": "on the stove", "counter": "on the counter"}
-FIXTURE_OF = {"sink": "Sink", "stove": "Stove"}
+FROM["microwave"], TO["microwave"] = "the microwave", "in the microwave"
+FROM["coffee machine"] = "the coffee machine"
+TO["coffee machine"] = "under the coffee machine's spout"
+FIXTURE_OF = {"sink": "Sink", "stove": "Stove", "microwave": "Microwave"}
+FIXTURE_OF["coffee machine"] = "Coffee"
+# regions behind a door: it stands open (rad) in the scene, as in RoboCasa's tasks
+OPEN_DOOR = {"microwave": 1.85}
 
 
 def _paraphrases(obj: str, start: str, goal: str) -> list[str]:
@@ -51,22 +60,29 @@ def pick_place(name: str, category: str, start: str, goal: str) -> TaskSpec:
     obj = category
     target = TO[goal]
     site, offset = GOAL_POINT[goal]
+    kwargs = {
+        "fixture": fixture,
+        "part": next(iter(_parts(fixture))),
+        "item": category,
+        "start": start,
+        "goal": goal,
+    }
+    where = goal if start == "counter" else start
+    if where in OPEN_DOOR:
+        kwargs.update(part="door", start_q=OPEN_DOOR[where])
+    proto = pick_place_protocol(obj, target, "goal:region")
+    if where in OPENINGS:  # reached through an opening: the hand points into it
+        proto["expert"] = "kitchen_forward"
     return TaskSpec(
         name=f"{SUITE}.{name}",
         env_name="RoverKitchen",
-        env_kwargs={
-            "fixture": fixture,
-            "part": next(iter(_parts(fixture))),
-            "item": category,
-            "start": start,
-            "goal": goal,
-        },
+        env_kwargs=kwargs,
         description=f"Pick the {obj} from {FROM[start]} and place it {target}.",
         paraphrases=_paraphrases(obj, start, goal),
         suite=SUITE,
         objects=[ObjectSpec(name=obj, body=host_body(category))],
         goals={"region": GoalSpec(kind="body", body=site, offset=offset)},
-        **pick_place_protocol(obj, target, "goal:region"),
+        **proto,
     )
 
 
@@ -81,4 +97,6 @@ TASKS: list[TaskSpec] = [
     pick_place("PickPlaceSinkToCounter", "vegetable", "sink", "counter"),
     pick_place("PickPlaceCounterToStove", "vegetable", "counter", "stove"),
     pick_place("PickPlaceStoveToCounter", "vegetable", "stove", "counter"),
+    pick_place("PickPlaceCounterToMicrowave", "food container", "counter", "microwave"),
+    pick_place("PickPlaceMicrowaveToCounter", "food container", "microwave", "counter"),
 ]

@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from rover.sim.kitchen.fixtures import COUNTER_TOP, FIXTURES
-from rover.sim.kitchen.objects import COLOUR_JITTER, half_height, instances
+from rover.sim.kitchen.forward_items import item_instances as instances
+from rover.sim.kitchen.objects import COLOUR_JITTER, half_height
 from rover.sim.kitchen.regions import (
     COUNTER_GAP,
     COUNTER_SIDE,
@@ -50,7 +51,7 @@ def draw_item(rng: np.random.Generator, env) -> dict:
         xy = w[:2]
         z = COUNTER_TOP + region.floor + half_height(inst)
     qpos = [float(xy[0]), float(xy[1]), z, float(np.cos(yaw / 2)), 0.0, 0.0, float(np.sin(yaw / 2))]
-    return {
+    out = {
         "name": inst.name,
         "category": inst.category,
         "rgb": [round(float(v), 3) for v in rgb],
@@ -59,6 +60,9 @@ def draw_item(rng: np.random.Generator, env) -> dict:
         "qpos": [round(v, 5) for v in qpos],
         "counter": [round(v, 4) for v in counter],
     }
+    if env.kind == "door":  # the fixture's door stands open for the item to pass
+        out["door"] = round(float(env.start_q), 4)
+    return out
 
 
 def item_bottom(env) -> float:

@@ -2,12 +2,15 @@
 
 A region is a box in a fixture's own frame (origin on the counter top at the fixture's
 base, front facing -x) plus the relation the facts report for an item resting there:
-``inside`` the sink basin, ``on`` the stove's cooktop, and ``on`` the counter for any
-free stretch of counter top (not under a fixture). An item is in a region when its
-centre lies within the box's footprint and its lowest point lies in the box's height
-band; the bands reach a few centimetres above the surface, so an item let go just above
-it (the scripted expert releases 1-3 cm up) is already in the region while it settles,
-and one falling from higher is not (a drop).
+``inside`` the sink basin, ``inside`` the microwave's cavity, ``on`` the stove's
+cooktop, ``on`` the coffee machine (its drip tray under the spout: the mug stands on the
+machine, as "on the stove"), and ``on`` the counter for any free stretch of counter top
+(not under a fixture). `OPENINGS` lists the regions reached through a fixture's front
+opening, which the forward grasp (`rover.sim.kitchen.forward_grasp`) serves. An item is
+in a region when its centre lies within the box's footprint and its lowest point lies in
+the box's height band; the bands reach a few centimetres above the surface, so an item
+let go just above it (the scripted expert releases 1-3 cm up) is already in the region
+while it settles, and one falling from higher is not (a drop).
 
 Pure data and geometry (no robosuite import): the env and the tests share it.
 """
@@ -79,23 +82,60 @@ REGIONS: dict[str, Region] = {
             start=(0.012, 0.012),
             site="burner",
         ),
+        # the microwave's cavity (inside: walls at x -0.12..0.11, y -0.19..0.08, floor top
+        # 1 cm up, roof at 19 cm); items start in its front half, within the hand's reach
+        Region(
+            "microwave",
+            "inside",
+            "Microwave",
+            (0.0, -0.055),
+            (0.11, 0.135),
+            0.01,
+            start=(0.01, 0.02),
+            site="interior",
+        ),
+        # the coffee machine's drip tray under the spout (top 2 cm up): a mug stands "on"
+        # the coffee machine when it rests there, centred within 5 cm of the spout
+        Region(
+            "coffee machine",
+            "on",
+            "Coffee",
+            (-0.04, 0.0),
+            (0.05, 0.06),
+            0.02,
+            start=(0.006, 0.01),
+            site="slot",
+        ),
         Region("counter", "on", None, (0.0, 0.0), (COUNTER_SIZE[0] / 2, COUNTER_SIZE[1] / 2), 0.0),
     )
 }
-START_IN = {"sink": (-0.06, 0.0), "stove": (0.005, -0.1)}  # start centre (fixture frame)
+START_IN = {
+    "sink": (-0.06, 0.0),
+    "stove": (0.005, -0.1),
+    "microwave": (-0.03, -0.055),
+    "coffee machine": (-0.04, 0.0),
+}  # start centre (fixture frame)
+# regions entered through a fixture's front opening (the coffee machine's: under its
+# head): the forward grasp (`rover.sim.kitchen.forward_grasp`) reaches them
+OPENINGS = ("microwave", "coffee machine")
 # fixture footprints on the counter (half x, half y, fixture frame): an item there is
 # not on the counter (it is on the fixture's deck, or in one of its regions)
 FOOTPRINT = {
     "Drawer": (0.1, 0.125),
     "Cabinet": (0.11, 0.14),
-    "Microwave": (0.13, 0.17),
+    "Microwave": (0.13, 0.2),
     "Coffee": (0.12, 0.09),
     "Stove": (0.15, 0.2),
     "Sink": (0.19, 0.18),
 }
 # where a counter spot (start or goal) is drawn beside the fixture in use: which side
 # along the counter (+1: +y), the gap from the fixture's edge and the x range
-COUNTER_SIDE = {"Sink": 1.0, "Stove": -1.0}
+COUNTER_SIDE = {
+    "Sink": 1.0,
+    "Stove": -1.0,
+    "Microwave": 1.0,
+    "Coffee": -1.0,
+}  # microwave: the panel side
 COUNTER_GAP = (0.09, 0.15)
 COUNTER_X = (-0.14, -0.05)
 
