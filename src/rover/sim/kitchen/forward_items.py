@@ -17,6 +17,10 @@ FORWARD_CATALOGUE: tuple[Instance, ...] = (
     Instance("food container", "noodle cup", "cylinder", (0.027, 0.04), (0.95, 0.9, 0.78, 1)),
     Instance("food container", "soup tub", "cylinder", (0.03, 0.035), (0.9, 0.45, 0.15, 1)),
     Instance("food container", "rice carton", "box", (0.021, 0.021, 0.04), (0.45, 0.7, 0.35, 1)),
+    # pantry items for the cabinet: a can, a jar and a carton
+    Instance("pantry item", "bean can", "cylinder", (0.03, 0.04), (0.7, 0.15, 0.15, 1)),
+    Instance("pantry item", "jam jar", "cylinder", (0.024, 0.037), (0.55, 0.1, 0.3, 1)),
+    Instance("pantry item", "juice carton", "box", (0.02, 0.024, 0.042), (0.95, 0.65, 0.15, 1)),
     # mugs for the coffee machine (robosuite HollowCylinderObject rings): three sizes
     Instance("mug", "travel mug", "mug", (0.03, 0.025, 0.045), (0.2, 0.25, 0.3, 1)),
     Instance("mug", "green mug", "mug", (0.031, 0.026, 0.038), (0.2, 0.6, 0.35, 1)),

@@ -33,6 +33,7 @@ GOAL_POINT = {
     "counter": ("kitchen_counter_goal", (0.0, 0.0, 0.0)),
     "microwave": ("Microwave_interior", (0.0, 0.0, 0.0)),
     "coffee machine": ("Coffee_slot", (0.0, 0.0, 0.0)),
+    "cabinet": ("Cabinet_inside", (0.0, 0.0, 0.0)),
 }
 # how the instruction names a region as a start ("from ...") and as a goal
 FROM = {"sink": "the sink", "stove": "the stove", "counter": "the counter"}
@@ -42,8 +43,10 @@ FROM["coffee machine"] = "the coffee machine"
 TO["coffee machine"] = "under the coffee machine's spout"
 FIXTURE_OF = {"sink": "Sink", "stove": "Stove", "microwave": "Microwave"}
 FIXTURE_OF["coffee machine"] = "Coffee"
+FIXTURE_OF["cabinet"] = "Cabinet"
+FROM["cabinet"], TO["cabinet"] = "the cabinet", "in the cabinet"
 # regions behind a door: it stands open (rad) in the scene, as in RoboCasa's tasks
-OPEN_DOOR = {"microwave": 1.85}
+OPEN_DOOR = {"microwave": 1.85, "cabinet": 1.7}
 
 
 def _paraphrases(obj: str, start: str, goal: str) -> list[str]:
@@ -93,10 +96,14 @@ def _parts(fixture: str) -> dict[str, str]:
 
 
 TASKS: list[TaskSpec] = [
+    pick_place("PickPlaceCabToCounter", "pantry item", "cabinet", "counter"),
+    pick_place("PickPlaceCounterToCab", "pantry item", "counter", "cabinet"),
     pick_place("PickPlaceCounterToSink", "vegetable", "counter", "sink"),
     pick_place("PickPlaceSinkToCounter", "vegetable", "sink", "counter"),
     pick_place("PickPlaceCounterToStove", "vegetable", "counter", "stove"),
     pick_place("PickPlaceStoveToCounter", "vegetable", "stove", "counter"),
     pick_place("PickPlaceCounterToMicrowave", "food container", "counter", "microwave"),
     pick_place("PickPlaceMicrowaveToCounter", "food container", "microwave", "counter"),
+    pick_place("CoffeeSetupMug", "mug", "counter", "coffee machine"),
+    pick_place("CoffeeServeMug", "mug", "coffee machine", "counter"),
 ]

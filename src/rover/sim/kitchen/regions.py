@@ -2,15 +2,16 @@
 
 A region is a box in a fixture's own frame (origin on the counter top at the fixture's
 base, front facing -x) plus the relation the facts report for an item resting there:
-``inside`` the sink basin, ``inside`` the microwave's cavity, ``on`` the stove's
-cooktop, ``on`` the coffee machine (its drip tray under the spout: the mug stands on the
-machine, as "on the stove"), and ``on`` the counter for any free stretch of counter top
-(not under a fixture). `OPENINGS` lists the regions reached through a fixture's front
-opening, which the forward grasp (`rover.sim.kitchen.forward_grasp`) serves. An item is
-in a region when its centre lies within the box's footprint and its lowest point lies in
-the box's height band; the bands reach a few centimetres above the surface, so an item
-let go just above it (the scripted expert releases 1-3 cm up) is already in the region
-while it settles, and one falling from higher is not (a drop).
+``inside`` the sink basin, the microwave's cavity and the cabinet's lower compartment,
+``on`` the stove's cooktop, ``on`` the coffee machine (its drip tray under the spout:
+the mug stands on the machine, as "on the stove"), and ``on`` the counter for any free
+stretch of counter top (not under a fixture). `OPENINGS` lists the regions reached
+through a fixture's front opening, which the forward grasp
+(`rover.sim.kitchen.forward_grasp`) serves. An item is in a region when its centre lies
+within the box's footprint and its lowest point lies in the box's height band; the
+bands reach a few centimetres above the surface, so an item let go just above it (the
+scripted expert releases 1-3 cm up) is already in the region while it settles, and one
+falling from higher is not (a drop).
 
 Pure data and geometry (no robosuite import): the env and the tests share it.
 """
@@ -106,6 +107,18 @@ REGIONS: dict[str, Region] = {
             start=(0.006, 0.01),
             site="slot",
         ),
+        # the cabinet's lower compartment (inside: walls at x -0.1..0.09, y -0.13..0.13,
+        # floor top 1 cm up, shelf at 16.1 cm); items start in its front half
+        Region(
+            "cabinet",
+            "inside",
+            "Cabinet",
+            (0.0, 0.0),
+            (0.09, 0.12),
+            0.01,
+            start=(0.01, 0.02),
+            site="inside",
+        ),
         Region("counter", "on", None, (0.0, 0.0), (COUNTER_SIZE[0] / 2, COUNTER_SIZE[1] / 2), 0.0),
     )
 }
@@ -114,10 +127,11 @@ START_IN = {
     "stove": (0.005, -0.1),
     "microwave": (-0.03, -0.055),
     "coffee machine": (-0.04, 0.0),
+    "cabinet": (-0.02, 0.0),
 }  # start centre (fixture frame)
 # regions entered through a fixture's front opening (the coffee machine's: under its
 # head): the forward grasp (`rover.sim.kitchen.forward_grasp`) reaches them
-OPENINGS = ("microwave", "coffee machine")
+OPENINGS = ("microwave", "coffee machine", "cabinet")
 # fixture footprints on the counter (half x, half y, fixture frame): an item there is
 # not on the counter (it is on the fixture's deck, or in one of its regions)
 FOOTPRINT = {
@@ -135,6 +149,7 @@ COUNTER_SIDE = {
     "Stove": -1.0,
     "Microwave": 1.0,
     "Coffee": -1.0,
+    "Cabinet": 1.0,
 }  # microwave: the panel side
 COUNTER_GAP = (0.09, 0.15)
 COUNTER_X = (-0.14, -0.05)
