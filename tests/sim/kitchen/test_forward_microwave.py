@@ -1,5 +1,5 @@
-"""Kitchen pick-and-place through an opening: the microwave region, the forward-grasp
-items and the forward expert in MuJoCo."""
+"""Kitchen pick-and-place through an opening: the microwave, cabinet and coffee-machine
+regions, the forward-grasp items, the level-hand start and the forward expert in MuJoCo."""
 
 from __future__ import annotations
 
@@ -45,6 +45,30 @@ def test_forward_items_fit_the_open_hand_at_any_yaw_and_stand_above_its_palm():
     assert item_instances("vegetable")[0].name == "tomato"  # the catalogue's, unchanged
 
 
+def test_cabinet_compartment_and_coffee_tray_regions():
+    cabinet = (np.array([0.15, -0.08, COUNTER_TOP]), 0.08)
+    half = 0.04
+    centre = to_world(np.array([-0.02, 0.01, 0.01 + half + 0.01]), *cabinet)
+    assert locate(centre, centre[2] - half, {"Cabinet": cabinet}) == ("inside", "cabinet")
+    # on the shelf above the compartment: in no region
+    centre = to_world(np.array([-0.02, 0.01, 0.169 + half]), *cabinet)
+    assert locate(centre, centre[2] - half, {"Cabinet": cabinet}) is None
+    coffee = (np.array([0.1, 0.0, COUNTER_TOP]), -0.1)
+    centre = to_world(np.array([-0.04, 0.0, 0.02 + half]), *coffee)
+    assert locate(centre, centre[2] - half, {"Coffee": coffee}) == ("on", "coffee machine")
+    # on the tray's front edge, 7 cm in front of the spout: not under it
+    centre = to_world(np.array([-0.11, 0.0, 0.02 + half]), *coffee)
+    assert locate(centre, centre[2] - half, {"Coffee": coffee}) is None
+
+
+def test_each_forward_category_has_three_told_apart_instances():
+    for category in ("food container", "pantry item", "mug"):
+        found = item_instances(category)
+        assert len(found) >= 3
+        assert len({(i.size, i.rgba) for i in found}) == len(found)
+        assert len({i.name for i in found}) == len(found)
+
+
 @pytest.fixture(scope="module")
 def to_microwave(sim_env):
     return sim_env("kitchen.PickPlaceCounterToMicrowave")
@@ -58,6 +82,11 @@ def test_microwave_door_stands_open_and_is_recorded(to_microwave):
     assert env.scene.to_json()["item"]["door"] == pytest.approx(1.85)
     assert env.scene.item["name"] in {i.name for i in item_instances("food container")}
     assert env.item_place() == ("on", "counter")
+    # the arm starts in the level-hand ready pose, the item's counter spot clear of it
+    approach = to_microwave.data.site_xmat[to_microwave._eef_site].reshape(3, 3)[:, 2]
+    assert abs(approach[2]) < 0.05 and approach[0] > 0.95
+    hand = to_microwave.point("eef")
+    assert np.linalg.norm((hand - to_microwave.point("food container"))[:2]) > 0.1
 
 
 @pytest.mark.sim
@@ -66,6 +95,8 @@ def test_microwave_door_stands_open_and_is_recorded(to_microwave):
     [
         ("kitchen.PickPlaceCounterToMicrowave", ("on", "counter"), ("inside", "microwave")),
         ("kitchen.PickPlaceMicrowaveToCounter", ("inside", "microwave"), ("on", "counter")),
+        ("kitchen.PickPlaceCounterToCab", ("on", "counter"), ("inside", "cabinet")),
+        ("kitchen.CoffeeServeMug", ("on", "coffee machine"), ("on", "counter")),
     ],
 )
 def test_forward_expert_moves_the_item_through_the_opening(sim_env, task, start, goal):
@@ -78,7 +109,8 @@ def test_forward_expert_moves_the_item_through_the_opening(sim_env, task, start,
     picks = np.linspace(0, len(demo.states) - 1, 30).round().astype(int)
     previous = demo.states[np.maximum(picks - 1, 0)]
     facts = facts_for_states(sim, demo.states[picks], previous)
-    first, last = facts[0].objects["food container"], facts[-1].objects["food container"]
+    obj = sim.spec.objects[0].name
+    first, last = facts[0].objects[obj], facts[-1].objects[obj]
     assert (first.inside or None, first.on or None) == (
         start[1] if start[0] == "inside" else None,
         start[1] if start[0] == "on" else None,
