@@ -4,11 +4,15 @@ Usage: python benchmarks/generate_speed.py [--tasks Lift,PickPlaceCan] [--episod
        [--frames 30] [--views left,wrist] [--size 128]
        python benchmarks/generate_speed.py --full [--tasks all] [--per-level 3] [--workers 2]
        [--views left,wrist] [--size 256]
+       python benchmarks/generate_speed.py --full --preset paper [--views left,wrist] [--keep DIR]
 
 ``--full`` times one whole `rover generate` run (every level, ``--per-level`` videos each,
 ``--workers`` processes, expert demos included), prints the load average before and after
 (the machine may be shared: compare runs made under similar load), and lists how many
 tries each level needed to meet its milestone (read from the written ``dataset.json``).
+``--preset paper`` makes it the paper preset's run (`rover generate --preset paper
+--available-only`: the kitchen tasks that exist, Table 5's videos per level, 30/60 frames),
+whose target is 30 minutes on 2 cores with 2 workers, 256 px, two views.
 
 Per task, after a warm-up episode (the first episode per process pays for building the
 env, the renderer and numba/EGL start-up): the full pipeline (perturb + value + facts +
@@ -49,13 +53,21 @@ def full_run(args: argparse.Namespace) -> None:
     from rover.sim.generate import generate
     from rover.sim.tasks import task_names
 
-    tasks = task_names() if args.tasks == "all" else args.tasks.split(",")
+    counts: dict[str, list[int]] = {}
+    if args.preset:  # the paper's shape: its tasks that exist, Table 5's videos per level
+        from rover.sim.kitchen.presets import paper_plan
+
+        tasks, counts, note = paper_plan(task_names("all"), available_only=True)
+        Console(width=150).print(note)
+    else:
+        tasks = task_names() if args.tasks == "all" else args.tasks.split(",")
     cfg = GenerateConfig(
         tasks=tasks,
         per_level=args.per_level,
         views=args.views.split(","),
         size=args.size if args.size else 256,
         seed=args.seed,
+        level_counts=counts,
     )
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(args.keep) if args.keep else Path(tmp) / "ds"
@@ -67,7 +79,8 @@ def full_run(args: argparse.Namespace) -> None:
         info = json.loads((out / "dataset.json").read_text())
     console = Console(width=150)
     console.print(
-        f"full run: {len(tasks)} tasks, {len(ids)} episodes, per-level {args.per_level}, "
+        f"full run: {len(tasks)} tasks, {len(ids)} episodes, "
+        f"{'--preset paper' if args.preset else f'per-level {args.per_level}'}, "
         f"{args.workers} workers, views {args.views}, {cfg.size} px: {wall:.1f} s wall "
         f"(load average 1/5/15 min before: {before}; after: {after})"
     )
@@ -101,7 +114,17 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--keep", default=None, help="--full: write the dataset here (kept)")
+    ap.add_argument(
+        "--preset",
+        choices=["paper"],
+        default=None,
+        help="--full: the paper preset's tasks that exist and Table 5's counts (not --tasks)",
+    )
     args = ap.parse_args()
+    if args.preset and not args.full:
+        ap.error("--preset goes with --full")
+    if args.preset and args.tasks:
+        ap.error("--preset sets the tasks itself; leave out --tasks")
     if args.full:
         args.tasks = args.tasks or "all"
         full_run(args)
