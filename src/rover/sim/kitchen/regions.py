@@ -148,9 +148,10 @@ COUNTER_SIDE = {
     "Sink": 1.0,
     "Stove": -1.0,
     "Microwave": 1.0,
-    "Coffee": -1.0,
+    "Coffee": 1.0,
     "Cabinet": 1.0,
-}  # microwave: the panel side
+}  # microwave: the panel side. The level hand's reach: on the -y side the ready pose's
+# arm family runs joint 2 into its limit at counter height (CoffeeSetupMug 17/20 there)
 COUNTER_GAP = (0.09, 0.15)
 COUNTER_X = (-0.14, -0.05)
 
