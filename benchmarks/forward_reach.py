@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/forward_reach.py [--steps 150] [--seed 0]
 
-The microwave (and later cabinet and coffee-machine) pick-and-place tasks take their
+The microwave, cabinet and coffee-machine pick-and-place tasks take their
 item with a hand that points horizontally into the fixture
 (`rover.sim.experts.Scripted.pitch = -pi/2`). This drives robosuite's OSC_POSE
 controller, as the experts do, toward level-hand targets in the scene of
