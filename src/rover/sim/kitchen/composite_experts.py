@@ -10,18 +10,43 @@ carry-and-lower placement. Two things differ from the tabletop pick-and-place sc
   meets the palm on its top and is pushed over; the fingers close `TOP_MARGIN` below
   its top instead;
 * the item is lowered to `DROP_DZ` above the goal surface before it is let go, so a
-  round item set on the cutting board does not bounce or roll off it.
+  round item set on the cutting board does not bounce or roll off it;
+* an item taken by a handle (the pan) is carried so that its centre, not the hand,
+  comes over the goal, at `PAN_CARRY` above it: low enough for the pan's rim to pass
+  under the sink spout's nozzle, high enough for its bottom to clear the basin's walls.
+
+A pair of subtasks on a fixture part (grasp the sink handle, turn it) is the faucet
+task's own expert (`rover.sim.kitchen.experts.turn_script`), after going home.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
+import numpy as np
+
 from rover.sim.env import SimEnv
-from rover.sim.motions import OPEN, Phase, Retry, object_z_range, pick_retry, place_phases
+from rover.sim.motions import (
+    CLOSE,
+    OPEN,
+    Phase,
+    Retry,
+    object_bottom,
+    object_z_range,
+    pick_phases,
+    pick_retry,
+    place_phases,
+)
 
 TOP_MARGIN = 0.045  # m below an item's top the fingers close (palm clear of it)
 DROP_DZ = 0.012  # m above the goal surface the item's bottom is let go
+PAN_CARRY = 0.16  # m above the goal point the hand carries an item held by its handle
+# rad the Panda's last joint starts from the middle of its range (pi/4 of +-2.9): the
+# hand's yaw that leaves it centred is the base joint's turn plus this
+WRIST_START = float(np.pi / 4)
+HANDLE_DZ = -0.008  # m: the grip point sits this far below a handle's centre line (the
+# finger pads' centre is above the grip site: closed at the site, they met above a 14 mm
+# thick handle)
 
 
 def grasp_dz(sim: SimEnv, obj: str) -> float:
@@ -31,19 +56,149 @@ def grasp_dz(sim: SimEnv, obj: str) -> float:
     return float(max(0.0, top - TOP_MARGIN - sim.point(obj)[2]))
 
 
+def held_place_phases(sim: SimEnv, goal: str, obj: str, drop_dz: float) -> list[Phase]:
+    """Carry an item held off its centre (a pan by its handle) so that its centre comes
+    over `goal`, lower its bottom to `drop_dz` above the goal point, release, retreat."""
+
+    def offset() -> np.ndarray:  # hand minus item centre, horizontal
+        d = sim.point("eef") - sim.point(obj)
+        d[2] = 0.0
+        return d
+
+    def reach() -> float:  # how far the item hangs below the grip point
+        return float(np.clip(sim.point("eef")[2] - object_bottom(sim, obj), 0.0, 0.2))
+
+    def over() -> np.ndarray:
+        g = sim.point(goal) + offset()
+        return np.array([g[0], g[1], sim.point(goal)[2] + PAN_CARRY])
+
+    def rise() -> np.ndarray:
+        e = sim.point("eef")
+        return np.array([e[0], e[1], over()[2]])
+
+    def down() -> np.ndarray:
+        return sim.point(goal) + offset() + np.array([0, 0, drop_dz + reach()])
+
+    rest: list[np.ndarray] = []
+
+    def freeze() -> np.ndarray:
+        if not rest:
+            rest.append(sim.point("eef"))
+        return rest[0]
+
+    return [
+        Phase(rise, CLOSE, tol=0.02, steps=40, gain=0.6),
+        Phase(over, CLOSE, tol=0.02, steps=120, gain=0.6),
+        Phase(down, CLOSE, tol=0.01, steps=60, gain=0.6),
+        Phase(freeze, OPEN, tol=None, steps=8),
+        Phase(lambda: freeze() + np.array([0, 0, 0.08]), OPEN, tol=0.02, steps=20),
+    ]
+
+
+def base_turn(sim: SimEnv, p: np.ndarray) -> float:
+    """The arm's base-joint turn toward point `p` (rad about z, 0 straight ahead)."""
+    base = sim.data.xpos[sim._body_id(sim.env.robots[0].robot_model.root_body)]
+    return float(np.arctan2(p[1] - base[1], p[0] - base[0]))
+
+
+def turned_pick(
+    sim: SimEnv,
+    obj: str,
+    goal: str,
+    period: float,
+    dz: float = 0.0,
+    point: str | None = None,
+    chosen: list[float] | None = None,
+) -> Retry:
+    """Pick an item whose grasp has a symmetry (`period`: a handle or a box, a half
+    turn) at the symmetric yaw that leaves the wrist's last joint the most room both at
+    the item and over its goal.
+
+    Reaching sideways turns the arm's base joint and the hand with it, so the yaw the
+    last joint needs no turn for is the base joint's; that joint starts `WRIST_START`
+    from the middle of its range. The yaw nearest the base turns at the grasp and at the
+    goal, moved by that offset, keeps the joint inside its range at both ends: a pan
+    handle taken at -pi/2 ran it into its limit 2.6 cm short of the handle, a sponge
+    taken at a yaw far from the carry's left the arm folded against joint 6's limit.
+    With `chosen` the carry turns the hand with the base (`carry_turned`), so only the
+    grasp's end counts, and the yaw taken is appended to it."""
+
+    def phases() -> list[Phase]:
+        out = pick_phases(sim, obj, period, dz, point)
+        at = base_turn(sim, sim.point(point or obj))
+        want = at if chosen is not None else (at + base_turn(sim, sim.point(goal))) / 2
+        want += WRIST_START
+        yaw = out[0].yaw()
+        best = min((yaw + k * period for k in (-2, -1, 0, 1, 2)), key=lambda y: abs(y - want))
+        out[0].yaw = lambda: best
+        if chosen is not None:
+            chosen[:] = [best, at]
+        return out
+
+    return Retry(phases, lambda: sim.predicate(f"lifted:{obj}"))
+
+
 def chained_pick_place(sim: SimEnv) -> list[Phase | Retry]:
-    """Pick and place each item of the task in turn, the hand back home between."""
+    """Pick and place each item of the task in turn, the hand back home between; a
+    fixture part's pair of subtasks (grasp, turn) with the faucet task's expert."""
+    from rover.sim.kitchen.experts import turn_script  # it imports this module
+
     phases: list[Phase | Retry] = []
     subs = sim.spec.subtasks
     home = sim.point("eef")
+    turned = False  # the last grasp took a yaw by its symmetry (a handle, a box)
     for k, (grasp, move) in enumerate(zip(subs[0::2], subs[1::2], strict=True)):
         obj = grasp.object
-        if k:  # back to the start pose first, as the tabletop pick-and-place script does
-            phases.append(Phase(lambda: home, OPEN, tol=0.03, steps=60))
-        phases.append(pick_retry(sim, obj, None, grasp_dz(sim, obj)))
+        if k:  # back to the start pose first, as the tabletop pick-and-place script does;
+            # after a turned grasp with the wrist unwound: a pan carried at a quarter turn
+            # left it where the next grasp's turn ran joint 6 into its limit
+            unwind = (lambda: 0.0) if turned else None
+            phases.append(Phase(lambda: home, OPEN, tol=0.03, steps=60, yaw=unwind))
+        if not sim.spec.object_spec(obj).graspable:  # the fixture part the task works
+            phases += turn_script(sim)
+            continue
+        point = grasp.object_points[0] if grasp.object_points[0] != obj else None
+        turned = point is not None or grasp_period(sim, obj) is not None
+        if point is not None:  # taken by a handle: fingers across the handle's width
+            phases.append(turned_pick(sim, obj, move.goal, np.pi, HANDLE_DZ, point))
+            phases += held_place_phases(sim, move.goal, obj, DROP_DZ)
+            continue
+        period = grasp_period(sim, obj)
         carry = float(sim.point(move.goal)[2]) + 0.20
-        phases += place_phases(sim, move.goal, DROP_DZ, carry, obj=obj)
+        if period is None:
+            phases.append(pick_retry(sim, obj, None, grasp_dz(sim, obj)))
+            phases += place_phases(sim, move.goal, DROP_DZ, carry, obj=obj)
+            continue
+        chosen: list[float] = []  # a box (a sponge): the hand turns with the arm's base
+        phases.append(turned_pick(sim, obj, move.goal, period, grasp_dz(sim, obj), None, chosen))
+        phases += carry_turned(sim, place_phases(sim, move.goal, DROP_DZ, carry, obj=obj), chosen)
     return phases
+
+
+def carry_turned(sim: SimEnv, phases: list[Phase], chosen: list[float]) -> list[Phase]:
+    """The carry, lowering and release of `place_phases` with the hand's yaw following
+    the arm's base turn from the grasp (`chosen`: yaw taken, base turn there), so the
+    wrist's last joint stays where the grasp left it: carried at a fixed yaw from the
+    counter's far side to the sink, the sponge folded the wrist against joint 6's limit
+    and the faucet lever was then out of reach."""
+
+    def yaw() -> float:
+        taken, at = chosen
+        return taken + base_turn(sim, sim.point("eef")) - at
+
+    for ph in phases[:4]:  # rise, over, down, let go; the retreat keeps the last yaw
+        ph.yaw, ph.track_yaw = yaw, True
+    return phases
+
+
+def grasp_period(sim: SimEnv, obj: str) -> float | None:
+    """Grasp symmetry of the item's drawn instance: a box (a sponge) is taken across its
+    narrow faces (half-turn symmetry), anything round at the clearest yaw (None)."""
+    from rover.sim.kitchen.objects import CATALOGUE
+
+    drawn = next((o["name"] for o in sim.env.scene.objects if o["role"] == obj), None)
+    shape = next((i.shape for i in CATALOGUE if i.name == drawn), None)
+    return np.pi if shape == "box" else None
 
 
 SCRIPTS: dict[str, Callable[[SimEnv], list[Phase | Retry]]] = {

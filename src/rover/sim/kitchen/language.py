@@ -67,6 +67,11 @@ PARAPHRASES: dict[str, list[str]] = {
         "Move the two vegetables onto the cutting board, one after the other.",
         "Take the vegetables from the counter and set them on the cutting board.",
     ],
+    "PreSoakPan": [
+        "Put the pan in the sink, place the sponge in it and turn the water on.",
+        "Set the pan in the sink with the sponge inside it, then switch the faucet on.",
+        "Move the pan into the sink, put the sponge in the pan and turn on the sink.",
+    ],
     "TurnSinkSpout": [
         "Swivel the faucet spout to the left.",
         "Swing the sink's spout over to the left side.",

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from rover.sim.kitchen.regions import SETTLE
 
 BOARD_HALF = (0.095, 0.13, 0.007)  # m: half depth (x), half length (y), half thickness
@@ -80,7 +82,14 @@ def item_body(role: ItemRole) -> str:
 START_SPOTS = {
     "counter far": ((-0.15, -0.07), (-0.27, -0.2)),
     "counter near": ((-0.15, -0.07), (-0.1, -0.06)),
+    # PreSoakPan (the sink in reach on the robot's right, y < 0.13 with its footprint):
+    # the pan beside it, the sponge in front of the pan, out of the pan's way
+    "counter beside sink": ((-0.1, -0.05), (0.24, 0.28)),
+    "counter front": ((-0.34, -0.3), (0.18, 0.24)),
 }
+# the start yaw range of an item per spot (default: any): the pan's handle points along
+# the counter, away from the sink, so it stays along the basin's length when set in it
+START_YAW = {"counter beside sink": (float(np.pi / 2 - 0.2), float(np.pi / 2 + 0.2))}
 
 
 def build_board():
