@@ -148,8 +148,8 @@ def held_contact_window(
     carton squeezed square-on), the demo has no touched-not-held stretch and
     `cut_window` gives none. The video then leaves the expert at that step: the frame
     shows the fingers on the object, and the level's ending opens them and backs the
-    hand off, without lifting it. (A hold that never lifts the object ends in neither a
-    drop nor a place: `rover.sim.facts.releases`.) None for any other case.
+    hand off, without lifting it. (A hold in which the object never moves ends in
+    neither a drop nor a place: `rover.sim.facts.releases`.) None for any other case.
     """
     L = level.level
     if level.completes or level.milestone_cut is None or L - 1 >= len(components):
