@@ -92,6 +92,15 @@ def _hold_after(marks: ExpertMarks, obj: str, t: int) -> tuple[int, int | None] 
     return None
 
 
+def _next_component(level: LevelSpec, components: Sequence[str]) -> str | None:
+    """The component a cut level fails (its L-th), or None for a level that is not cut
+    by milestone (the top level, a level without `milestone_cut`, one past the list)."""
+    L = level.level
+    if level.completes or level.milestone_cut is None or L - 1 >= len(components):
+        return None
+    return components[L - 1]
+
+
 def cut_window(
     level: LevelSpec,
     components: Sequence[str],
@@ -108,9 +117,9 @@ def cut_window(
     None when the demo never shows a component the level needs, or the stretch is empty.
     """
     L = level.level
-    if level.completes or level.milestone_cut is None or L - 1 >= len(components):
+    nxt = _next_component(level, components)
+    if nxt is None:
         return None
-    nxt = components[L - 1]
     kind = component_kind(nxt)
     obj = nxt.partition(":")[2]
     lo = _all_shown(marks, L - 1)
@@ -152,10 +161,8 @@ def held_contact_window(
     neither a drop nor a place: `rover.sim.facts.releases`.) None for any other case.
     """
     L = level.level
-    if level.completes or level.milestone_cut is None or L - 1 >= len(components):
-        return None
-    nxt = components[L - 1]
-    if component_kind(nxt) != "pick_up":  # (a hold would show a "grasp" component)
+    nxt = _next_component(level, components)
+    if nxt is None or component_kind(nxt) != "pick_up":  # (a hold shows as "grasp")
         return None
     lo = _all_shown(marks, L - 1)
     if lo is None or lo == 0:
