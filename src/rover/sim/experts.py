@@ -18,6 +18,7 @@ from scipy.spatial.transform import Rotation
 from rover.sim.env import SimEnv
 from rover.sim.experts_articulated import SCRIPTS as ARTICULATED_SCRIPTS
 from rover.sim.kitchen.experts import SCRIPTS as KITCHEN_SCRIPTS
+from rover.sim.kitchen.forward_chain import SCRIPTS as FORWARD_CHAIN_SCRIPTS
 from rover.sim.kitchen.forward_grasp import FORWARD_PITCH, HAND_DOWN
 from rover.sim.kitchen.forward_grasp import SCRIPTS as FORWARD_SCRIPTS
 from rover.sim.motions import (
@@ -253,7 +254,8 @@ SCRIPTS: dict[str, Callable[[SimEnv], list[Phase | Retry]]] = {
 SCRIPTS.update(ARTICULATED_SCRIPTS)  # drawer, button, knob (rover's own fixtures)
 SCRIPTS.update(KITCHEN_SCRIPTS)  # kitchen dials and hinged parts, either direction
 SCRIPTS.update(FORWARD_SCRIPTS)  # the forward grasp into the microwave, cabinet, coffee slot
-_PITCH = {name: FORWARD_PITCH for name in FORWARD_SCRIPTS}
+SCRIPTS.update(FORWARD_CHAIN_SCRIPTS)  # ... chained: RestockPantry, PrepareCoffee
+_PITCH = {name: FORWARD_PITCH for name in (*FORWARD_SCRIPTS, *FORWARD_CHAIN_SCRIPTS)}
 
 
 def run_expert(sim: SimEnv, seed: int) -> Demo:

@@ -26,13 +26,16 @@ import numpy as np
 
 from rover.sim.kitchen.env import RoverKitchen, _yaw_quat
 from rover.sim.kitchen.fixtures import COUNTER_TOP, FIXTURES
+from rover.sim.kitchen.forward_items import instance_named
+from rover.sim.kitchen.forward_items import item_instances as instances  # (forward table first)
 from rover.sim.kitchen.items import ItemGeoms, build_item, mass_inertia
-from rover.sim.kitchen.objects import CATALOGUE, COLOUR_JITTER, half_height, instances
+from rover.sim.kitchen.objects import COLOUR_JITTER, half_height
 from rover.sim.kitchen.pan import PAN_REGION, build_pan_item, pan_mass_inertia, site_positions
 from rover.sim.kitchen.placement import item_bottom
 from rover.sim.kitchen.regions import locate, to_local
 from rover.sim.kitchen.scene import Scene
 from rover.sim.kitchen.utensils import (
+    BESIDE_SPOTS,
     BOARD_BODY,
     BOARD_REGION,
     BOARD_X,
@@ -77,7 +80,7 @@ def clear_decor(decor: list[dict], objects: list[dict]) -> list[dict]:
     for d in decor:
         near = False
         for obj in objects:
-            inst = next(i for i in CATALOGUE if i.name == obj["name"])
+            inst = instance_named(obj["name"])
             reach = handle_length(inst) / 2 if inst.category == "pan" else max(inst.size[:2])
             gap = float(np.hypot(d["x"] - obj["qpos"][0], d["y"] - obj["qpos"][1]))
             near = near or gap < reach + DECOR_GAP
@@ -211,8 +214,10 @@ class RoverKitchenComposite(RoverKitchen):
             inst = options[int(rng.integers(len(options)))]
             used.add(inst.name)
             rgb = np.clip(np.asarray(inst.rgba[:3]) + rng.uniform(-1, 1, 3) * COLOUR_JITTER, 0, 1)
-            (x0, x1), (y0, y1) = START_SPOTS[role.start]
+            (x0, x1), (y0, y1) = START_SPOTS.get(role.start) or BESIDE_SPOTS[role.start]
             x, y = float(rng.uniform(x0, x1)), float(rng.uniform(y0, y1))
+            if role.start in BESIDE_SPOTS:  # y from the fixture's +y edge along the counter
+                y += self.scene.layout[self.fixture_name].y + FIXTURES[self.fixture_name].half_width
             yaw = float(rng.uniform(*START_YAW.get(role.start, (-np.pi, np.pi))))
             z = COUNTER_TOP + half_height(inst)
             qpos = [x, y, z, float(np.cos(yaw / 2)), 0.0, 0.0, float(np.sin(yaw / 2))]
@@ -237,7 +242,7 @@ class RoverKitchenComposite(RoverKitchen):
         for obj in scene.objects:
             name = obj["role"]
             self.role_geoms[name].show(m, obj["name"], obj["rgb"])
-            inst = next(i for i in CATALOGUE if i.name == obj["name"])
+            inst = instance_named(obj["name"])
             bid = self.role_body_ids[name]
             weigh = pan_mass_inertia if inst.category == "pan" else mass_inertia
             m.body_mass[bid], m.body_inertia[bid] = weigh(inst)
@@ -299,7 +304,7 @@ class RoverKitchenComposite(RoverKitchen):
             rot = d.xmat[bid].reshape(3, 3)
             local = rot.T @ (np.asarray(centre) - d.xpos[bid])
             low = bottom - d.xpos[bid][2]  # the pan stands level: height is z
-            inst = next(i for i in CATALOGUE if i.name == obj["name"])
+            inst = instance_named(obj["name"])
             if PAN_REGION.holds(inst, local, low):
                 return "inside", PAN_REGION.name
         return None

@@ -72,6 +72,16 @@ PARAPHRASES: dict[str, list[str]] = {
         "Set the pan in the sink with the sponge inside it, then switch the faucet on.",
         "Move the pan into the sink, put the sponge in the pan and turn on the sink.",
     ],
+    "RestockPantry": [
+        "Put both pantry items from the counter into the cabinet.",
+        "Stock the cabinet with the two pantry items from the counter, one after the other.",
+        "Take the two items off the counter and put them away in the cabinet.",
+    ],
+    "PrepareCoffee": [
+        "Set the mug under the coffee machine's spout and press its start button.",
+        "Put the mug in the coffee machine, then switch the machine on.",
+        "Place the mug on the coffee machine's drip tray and start the machine.",
+    ],
     "TurnSinkSpout": [
         "Swivel the faucet spout to the left.",
         "Swing the sink's spout over to the left side.",

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from rover.sim.kitchen.composites import TASKS as COMPOSITE_TASKS
+from rover.sim.kitchen.forward_composites import TASKS as FORWARD_COMPOSITE_TASKS
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
 from rover.sim.levels import by_milestone
@@ -368,3 +369,4 @@ TASKS: list[TaskSpec] = [
 TASKS = [t.model_copy(update={"levels": by_milestone(t.levels, t.milestones)}) for t in TASKS]
 TASKS += PICK_PLACE_TASKS  # the pick-and-place group (rover.sim.kitchen.pick_place)
 TASKS += COMPOSITE_TASKS  # the composite groups (rover.sim.kitchen.composites)
+TASKS += FORWARD_COMPOSITE_TASKS  # composites into openings (kitchen.forward_composites)

@@ -87,6 +87,18 @@ START_SPOTS = {
     "counter beside sink": ((-0.1, -0.05), (0.24, 0.28)),
     "counter front": ((-0.34, -0.3), (0.18, 0.24)),
 }
+# spots measured from the fixture in use (x: counter frame; y: from the fixture's +y
+# edge along the counter), for fixtures drawn in a range of places: the forward-grasp
+# composites (RestockPantry, PrepareCoffee) take items from beside the cabinet or the
+# coffee machine, on its +y side as the pick-and-place tasks do (`regions.COUNTER_SIDE`)
+BESIDE_SPOTS = {
+    # CoffeeSetupMug's counter spot (`regions.COUNTER_X`, `regions.COUNTER_GAP`)
+    "beside fixture": ((-0.14, -0.05), (0.09, 0.15)),
+    # two items one behind the other: the front one is taken first, so the hand never
+    # reaches past an item to get the other
+    "beside fixture front": ((-0.17, -0.13), (0.09, 0.14)),
+    "beside fixture back": ((-0.06, -0.03), (0.09, 0.14)),
+}
 # the start yaw range of an item per spot (default: any): the pan's handle points along
 # the counter, away from the sink, so it stays along the basin's length when set in it
 START_YAW = {"counter beside sink": (float(np.pi / 2 - 0.2), float(np.pi / 2 + 0.2))}

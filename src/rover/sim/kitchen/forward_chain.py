@@ -1,0 +1,89 @@
+"""The chained forward-grasp expert of RestockPantry and PrepareCoffee.
+
+For each (pick up, place) pair of subtasks: `forward_grasp.forward_pick` from the
+counter and `forward_grasp.forward_place` into the goal region (both with the hand level,
+pointing into the fixture in use), then back to the level-hand start point before the
+next pair (the hand stays level: robosuite's hand-down start cannot be turned level at
+counter height, `forward_grasp`'s docstring). A (reach, press) pair on the fixture's
+button is `press_phases`: the closed, level hand pressed down on it.
+
+Registered as ``kitchen_forward_chain``; `rover.sim.experts` runs it with the forward
+grasp's pitch (the hand level) like ``kitchen_forward``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from rover.sim.env import SimEnv
+from rover.sim.kitchen.forward_grasp import (
+    approach_yaw,
+    forward_pick,
+    forward_place,
+    region_floor_z,
+)
+from rover.sim.kitchen.regions import OPENINGS
+from rover.sim.motions import CLOSE, OPEN, Phase, Retry
+
+PRESS_ABOVE = 0.08  # m above the button's top the hand turns down (fingers closed)
+PRESS_PITCH = -0.8  # rad
+
+
+def press_phases(sim: SimEnv, yaw: float) -> list[Phase]:
+    """Turn the closed hand down above the button (`Phase.pitch` 0: the hand-down frame)
+    and press it past its switching depth with the fingertips, as the button task's
+    expert does; held down at the end (a spring button rises again when let go).
+
+    Pressed with the level hand the palm's underside meets the machine's head before
+    the button is 1 cm down, and the fingers, which the touch and press facts read,
+    never reach it."""
+    fx = sim.env
+
+    def top() -> np.ndarray:
+        return sim.point("button:top")
+
+    def pressed() -> np.ndarray:  # a little below the switching depth (the tabletop rule)
+        return fx.site_at("top", fx.target * 1.3) + np.array([0.0, 0.0, -0.004])
+
+    above = np.array([0.0, 0.0, PRESS_ABOVE])
+    return [
+        Phase(lambda: top() + above, CLOSE, tol=0.02, steps=80, yaw=lambda: yaw),
+        Phase(lambda: top() + above, CLOSE, tol=0.015, steps=80, pitch=PRESS_PITCH),
+        Phase(lambda: top() + np.array([0, 0, 0.01]), CLOSE, tol=0.006, steps=50, gain=1.2),
+        Phase(pressed, CLOSE, tol=None, steps=40, gain=0.5, done=fx.reached),
+        Phase(pressed, CLOSE, tol=None, steps=6, gain=0.5),  # hold it down
+    ]
+
+
+def forward_chain(sim: SimEnv) -> list[Phase | Retry]:
+    """Each item in turn with the forward grasp, home between; then the button, if any."""
+    env = sim.env
+    yaw = approach_yaw(sim)
+    home = sim.point("eef")
+    phases: list[Phase | Retry] = []
+    subs = sim.spec.subtasks
+    for k, (first, second) in enumerate(zip(subs[0::2], subs[1::2], strict=True)):
+        if k:  # back to the level-hand start point, still pointing into the fixture
+            phases.append(Phase(lambda: home, OPEN, tol=0.03, steps=60, yaw=lambda: yaw))
+        if not sim.spec.object_spec(first.object).graspable:  # the fixture's button
+            phases += press_phases(sim, yaw)
+            continue
+        obj = first.object
+        goal = env.role(obj).goal
+        phases.append(forward_pick(sim, obj, yaw, region_floor_z("counter")))
+        phases += forward_place(
+            sim,
+            obj,
+            lambda g=second.goal: sim.point(g),
+            region_floor_z(goal),
+            yaw,
+            into=goal in OPENINGS,
+        )
+    return phases
+
+
+SCRIPTS: dict[str, Callable[[SimEnv], list[Phase | Retry]]] = {
+    "kitchen_forward_chain": forward_chain,
+}
