@@ -31,6 +31,8 @@ SIGNALS = ("drawer_opened", "drawer_closed", "door_opened", "door_closed", "pres
 # articulated part (= task object) names; a kitchen "door" closed by its task is one too
 # (an opened door's events come from `rover.sim.facts`, as robosuite's Door's)
 PARTS = ("drawer", "button", "knob", "door", "stop button", "sink handle", "sink spout")
+# a door a composite task works twice, opened and later closed (MicrowaveThawing)
+PARTS += ("microwave door",)
 # parts turned through a fraction of a target turn: dials, and the kitchen sink's
 # faucet handle and swivelling spout (named for what they are)
 TURNED = ("knob", "sink handle", "sink spout")
@@ -45,14 +47,42 @@ def fixture(sim: SimEnv):
     return env if hasattr(env, "joint_qpos_addr") and getattr(env, "part", "") else None
 
 
+def part_keys(fx) -> tuple[str, ...]:
+    """The worked parts of a fixture env that works several in order (a kitchen
+    composite's `parts`), by key; empty for the usual one-part env."""
+    return tuple(getattr(fx, "part_keys", ()))
+
+
+def signal_part(sim: SimEnv, signal: str) -> str | None:
+    """The worked part whose joint the subtask ending on `signal` follows (its
+    ``joint:<key>`` point); None in a one-part env."""
+    keys = part_keys(fixture(sim))
+    for s in sim.spec.subtasks:
+        if s.end_signal == signal and s.joint and s.joint[6:] in keys:
+            return s.joint[6:]
+    return None
+
+
 def predicate(sim: SimEnv, kind: str, obj: str) -> bool | None:
-    """Evaluate ``kind:obj`` if it is a fixture signal; None when it is not one."""
+    """Evaluate ``kind:obj`` if it is a fixture signal; None when it is not one. With
+    several worked parts, the part the signal's subtask follows is asked."""
     if kind == "touched":
         return obj in sim.finger_contacts()
     fx = fixture(sim)
     if kind in SIGNALS and fx is not None:
-        return bool(fx.reached())
+        key = signal_part(sim, f"{kind}:{obj}")
+        return bool(fx.reached() if key is None else fx.reached_part(key))
     return None
+
+
+def progress(sim: SimEnv, key: str) -> float:
+    """Fraction of the motion to its target done by the part ``joint:<key>`` names
+    (the env's one part, or the worked part `key`)."""
+    fx = fixture(sim)
+    if key in part_keys(fx):
+        with fx.working(key):
+            return float(fx.progress())
+    return float(fx.progress())
 
 
 def holdable(sim: SimEnv, name: str) -> bool:
@@ -70,6 +100,9 @@ def goal(sim: SimEnv, g: GoalSpec) -> np.ndarray:
     fx = fixture(sim)
     if fx is None or g.body is None:
         raise ValueError(f"goal kind 'fixture' needs a fixture environment and a site ({g})")
+    if g.object in part_keys(fx):  # one of several worked parts: at its own target
+        with fx.working(g.object):
+            return fx.site_at(g.body, fx.target) + np.asarray(g.offset, dtype=np.float64)
     return fx.site_at(g.body, fx.target) + np.asarray(g.offset, dtype=np.float64)
 
 
@@ -79,11 +112,28 @@ def articulation_facts(sim: SimEnv) -> tuple[dict[str, float], list[str]]:
     ``drawer`` (and a kitchen ``door``): opening fraction (0 closed, 1 fully open, also
     when closing it); ``button``: 1.0 while pressed past the switching depth (the
     appliance is on), else 0.0; ``stop button``: the same (1.0: the appliance is off);
-    ``knob``: fraction of the target turn.
+    ``knob``: fraction of the target turn. An env working several parts gives each
+    its own entry (a part worked twice, once: its facts do not depend on the entry).
     """
     fx = fixture(sim)
     if fx is None:
         return {}, []
+    keys = part_keys(fx)
+    if not keys:
+        return _part_facts(fx)
+    out: dict[str, float] = {}
+    pressed: list[str] = []
+    for key in keys:
+        with fx.working(key):
+            if fx.part not in out:
+                facts, down = _part_facts(fx)
+                out.update(facts)
+                pressed += down
+    return out, pressed
+
+
+def _part_facts(fx) -> tuple[dict[str, float], list[str]]:
+    """`articulation_facts` of the env's current part."""
     pressed = [fx.part] if fx.part in BUTTONS and fx.pressed() else []
     if fx.part in ("drawer", "door"):
         value = fx.opening()
@@ -96,8 +146,8 @@ def articulation_facts(sim: SimEnv) -> tuple[dict[str, float], list[str]]:
     return {fx.part: round(float(value), 2)}, pressed
 
 
-def _first(facts: list[FrameFacts], test) -> int | None:
-    return next((t for t, f in enumerate(facts) if test(f)), None)
+def _first(facts: list[FrameFacts], test, after: int = 0) -> int | None:
+    return next((t for t, f in enumerate(facts) if t >= after and test(f)), None)
 
 
 def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[Event]:
@@ -118,6 +168,17 @@ def fixture_events(spec: TaskSpec, name: str, facts: list[FrameFacts]) -> list[E
     signals = {s.end_signal.partition(":")[0] for s in spec.subtasks}
     # a grasp, as for free objects: a hold begins (both fingers on it, moving with the hand)
     grasp = ev("grasp", _first(facts, lambda f: f.holding == name))
+    own = {s.end_signal for s in spec.subtasks if s.object == name}
+    if {f"door_opened:{name}", f"door_closed:{name}"} <= own:  # opened, later closed
+        opened = _first(facts, lambda f: value(f) >= FINISH)
+        after = opened if opened is not None else len(facts)
+        return [
+            grasp,
+            ev("open_start", _first(facts, lambda f: value(f) > START)),
+            ev("open_finish", opened),
+            ev("close_start", _first(facts, lambda f: value(f) < FINISH, after)),
+            ev("close_finish", _first(facts, lambda f: value(f) <= CLOSED_AT, after)),
+        ]
     if name in ("drawer", "door") and f"{name}_closed" in signals:
         return [
             grasp,

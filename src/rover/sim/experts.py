@@ -21,6 +21,7 @@ from rover.sim.kitchen.experts import SCRIPTS as KITCHEN_SCRIPTS
 from rover.sim.kitchen.forward_chain import SCRIPTS as FORWARD_CHAIN_SCRIPTS
 from rover.sim.kitchen.forward_grasp import FORWARD_PITCH, HAND_DOWN
 from rover.sim.kitchen.forward_grasp import SCRIPTS as FORWARD_SCRIPTS
+from rover.sim.kitchen.thawing_expert import SCRIPTS as THAWING_SCRIPTS
 from rover.sim.motions import (
     CLOSE,
     GRASP_DZ,
@@ -89,6 +90,8 @@ class Scripted:
         return np.concatenate([pos, rot, [grip]])
 
     def run(self, phase: Phase) -> None:
+        if phase.pitch is not None:
+            self.pitch = phase.pitch
         yaw = self.yaw0 if phase.yaw is None else phase.yaw()
         self.yaw0 = yaw
         errs: list[tuple[float, float]] = []  # (position error m, orientation error rad)
@@ -256,6 +259,8 @@ SCRIPTS.update(KITCHEN_SCRIPTS)  # kitchen dials and hinged parts, either direct
 SCRIPTS.update(FORWARD_SCRIPTS)  # the forward grasp into the microwave, cabinet, coffee slot
 SCRIPTS.update(FORWARD_CHAIN_SCRIPTS)  # ... chained: RestockPantry, PrepareCoffee
 _PITCH = {name: FORWARD_PITCH for name in (*FORWARD_SCRIPTS, *FORWARD_CHAIN_SCRIPTS)}
+SCRIPTS.update(THAWING_SCRIPTS)  # MicrowaveThawing: level hand, turned down to press start
+_PITCH.update({name: FORWARD_PITCH for name in THAWING_SCRIPTS})
 
 
 def run_expert(sim: SimEnv, seed: int) -> Demo:

@@ -31,6 +31,10 @@ class Phase:
     gain: float = 1.0
     track_yaw: bool = False  # re-evaluate `yaw` every step (turning with a door)
     done: Callable[[], bool] | None = None  # extra completion test
+    # the hand's pitch from here on (rad about world y, as `Scripted.pitch`; None: keep):
+    # a script that points the hand level into the microwave turns it down to press a
+    # button on the microwave's top
+    pitch: float | None = None
 
 
 @dataclass

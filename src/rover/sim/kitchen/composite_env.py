@@ -19,6 +19,8 @@ under ``extra.scene.objects`` and ``extra.scene.board``.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 
@@ -89,6 +91,40 @@ def clear_decor(decor: list[dict], objects: list[dict]) -> list[dict]:
     return kept
 
 
+@dataclass(frozen=True)
+class WorkedPart:
+    """One fixture part a composite task works, one entry per subtask that moves a joint.
+
+    A part may be worked more than once (the microwave door opened, later closed): each
+    time is its own entry, with its own `key`, start and target on the same joint.
+
+    Attributes:
+        key: what the subtask's ``joint:<key>`` point and its ``fixture`` goal's
+            ``object`` name it by ("microwave door closed").
+        part: the fixture's part (`rover.sim.kitchen.fixtures.Fixture.joints`): "door".
+        facts_as: the name the facts and events give the part ("microwave door"); the
+            same for every entry on one joint.
+        start_q, target, reach: as `FixtureEnv`'s, for this entry's motion.
+        with_items: the entry counts as reached only with every item in its goal. A
+            door closed again ends where it started: shut, the subtask's end test would
+            already hold at the first frame (and progress would value the start as that
+            subtask done); shut on the food inside is what the subtask achieves.
+    """
+
+    key: str
+    part: str
+    facts_as: str
+    start_q: float = 0.0
+    target: float = 0.0
+    reach: float = 0.9
+    with_items: bool = False
+
+
+# the FixtureEnv attributes saying which joint is "the" joint and its motion (`working`)
+_ACTIVE = ("kind", "_part", "joint", "joint_name", "joint_id", "joint_qpos_addr")
+_MOTION = ("start_q", "target", "reach")
+
+
 @dataclass
 class CompositeScene(Scene):
     """A kitchen scene plus the composite task's items and the board (JSON-able)."""
@@ -109,6 +145,12 @@ class RoverKitchenComposite(RoverKitchen):
             PreSoakPan's sink spout stands swung aside, out of the arm's way.
         articulated: whether the task works the fixture part (its joint facts and
             success); otherwise the fixture is only scenery.
+        parts: several parts of the fixture worked in order (`WorkedPart` fields per
+            entry): the door, then the start button. The first entry is the env's joint;
+            `working(key)` makes another one it, so the articulation facts, goals and
+            experts read that part (`rover.sim.articulation` asks every entry for its
+            facts). Implies ``articulated``; `part`, ``facts_as`` and the motion
+            arguments are then the first entry's.
         **kwargs: as `RoverKitchen` (``facts_as``, ``start_q``, ``target``, ...).
     """
 
@@ -121,11 +163,20 @@ class RoverKitchenComposite(RoverKitchen):
         board: bool = False,
         articulated: bool = False,
         scenery_q: dict[str, float] | None = None,
+        parts: list[dict] | tuple = (),
         **kwargs,
     ) -> None:
         self.roles = [ItemRole(*r) for r in items]
         self.has_board = board
-        self.articulated = articulated
+        self.worked = [WorkedPart(**p) for p in parts]
+        if len({w.key for w in self.worked}) != len(self.worked):
+            raise ValueError(f"worked parts need distinct keys: {[w.key for w in self.worked]}")
+        if self.worked:
+            first = self.worked[0]
+            part = first.part
+            kwargs.update(facts_as=first.facts_as, start_q=first.start_q)
+            kwargs.update(target=first.target, reach=first.reach)
+        self.articulated = articulated or bool(self.worked)
         self.scenery_q = dict(scenery_q or {})
         self.role_geoms: dict[str, ItemGeoms] = {}
         super().__init__(robots, fixture=fixture, part=part, **kwargs)
@@ -138,6 +189,45 @@ class RoverKitchenComposite(RoverKitchen):
     @part.setter
     def part(self, value: str) -> None:
         self._part = value
+
+    # ------------------------------------------------------------ worked parts
+    @property
+    def part_keys(self) -> tuple[str, ...]:
+        """Keys of the worked parts in order (empty: the task works at most one part)."""
+        return tuple(w.key for w in self.worked)
+
+    def worked_part(self, key: str) -> WorkedPart:
+        for w in self.worked:
+            if w.key == key:
+                return w
+        raise KeyError(f"no worked part {key!r} (parts: {list(self.part_keys)})")
+
+    @contextmanager
+    def working(self, key: str) -> Iterator[None]:
+        """Make worked part `key` the env's joint inside the block (`joint_value`,
+        `progress`, `site_at`, `reached`, `opening`, `pressed`, `part` read it)."""
+        w = self.worked_part(key)
+        saved = {a: getattr(self, a) for a in (*_ACTIVE, *_MOTION)}
+        name, jid, addr = self._part_joints[w.part]
+        joint = FIXTURES[self.fixture_name].joints[w.part]
+        values = (w.part, w.facts_as, joint, name, jid, addr, w.start_q, w.target, w.reach)
+        try:
+            for a, v in zip((*_ACTIVE, *_MOTION), values, strict=True):
+                setattr(self, a, v)
+            yield
+        finally:
+            for a, v in saved.items():
+                setattr(self, a, v)
+
+    def reached_part(self, key: str) -> bool:
+        """Whether worked part `key` has gone (nearly) all the way to its target (and,
+        for a `WorkedPart.with_items` entry, every item rests in its goal)."""
+        if self.worked_part(key).with_items and not all(
+            self.object_in_goal(r.name) for r in self.roles
+        ):
+            return False
+        with self.working(key):
+            return bool(self.reached())
 
     # ---------------------------------------------------------------- model
     def _load_model(self) -> None:
@@ -175,6 +265,11 @@ class RoverKitchenComposite(RoverKitchen):
                 r.name: ItemGeoms.of(m._model, r.category, r.prefix) for r in self.roles
             }
         self.board_body_id = m.body_name2id(BOARD_BODY) if self.has_board else None
+        self._part_joints = {}  # fixture part -> (joint name, id, qpos address)
+        for w in self.worked:
+            joint = self.fixture.naming_prefix + FIXTURES[self.fixture_name].joints[w.part]
+            jid = m.joint_name2id(joint)
+            self._part_joints[w.part] = (joint, jid, m.get_joint_qpos_addr(joint))
 
     # ---------------------------------------------------------------- reset
     def _reset_internal(self) -> None:
@@ -195,6 +290,13 @@ class RoverKitchenComposite(RoverKitchen):
             joint = self.fixture.naming_prefix + FIXTURES[self.fixture_name].joints[part]
             d.qpos[m.get_joint_qpos_addr(joint)] = q
             d.qvel[int(m._model.jnt_dofadr[m.joint_name2id(joint)])] = 0.0
+        started: set[str] = set()
+        for w in self.worked:  # each worked joint at its first entry's start
+            if w.part not in started:
+                started.add(w.part)
+                _, jid, addr = self._part_joints[w.part]
+                d.qpos[addr] = w.start_q
+                d.qvel[int(m._model.jnt_dofadr[jid])] = 0.0
         self.sim.forward()
 
     def _draw_composite(self) -> tuple[list[dict], dict | None]:
@@ -317,4 +419,7 @@ class RoverKitchenComposite(RoverKitchen):
         if not self.roles:
             return super()._check_success()
         done = all(self.object_in_goal(r.name) for r in self.roles)
+        if self.worked:  # every worked joint where its last entry takes it
+            last = {w.facts_as: w.key for w in self.worked}
+            return done and all(self.reached_part(k) for k in last.values())
         return done and (not self.articulated or bool(self.reached()))

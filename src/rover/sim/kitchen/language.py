@@ -82,6 +82,11 @@ PARAPHRASES: dict[str, list[str]] = {
         "Put the mug in the coffee machine, then switch the machine on.",
         "Place the mug on the coffee machine's drip tray and start the machine.",
     ],
+    "MicrowaveThawing": [
+        "Put the food item in the microwave, shut its door and start it.",
+        "Open the microwave, place the food inside, close the door and press start.",
+        "Thaw the food item: into the microwave with it, door closed, start button pressed.",
+    ],
     "TurnSinkSpout": [
         "Swivel the faucet spout to the left.",
         "Swing the sink's spout over to the left side.",

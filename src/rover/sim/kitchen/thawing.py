@@ -1,0 +1,174 @@
+"""kitchen.MicrowaveThawing: open the microwave, put the food in, close it, start it.
+
+The paper's "Microwave thawing" group (Table 4) chains four atomic tasks in one 60-frame
+video, on two parts of one fixture: the microwave's door (opened, later closed) and its
+start button. `RoverKitchenComposite(parts=...)` works both: each subtask that moves a
+joint names its entry (`WorkedPart`) by its ``joint:<key>`` point, so the door's opening
+follows the door's hinge toward open, its closing the same hinge toward shut, and the
+press the button's slide; facts and events come from each part's own joint
+(`rover.sim.articulation`). The food is a "food container" of the forward-grasp table
+(`rover.sim.kitchen.forward_items`: upright tubs and a carton a level hand can hold; the
+object catalogue's frozen food is flat, sized for a top-down grasp, and the cavity is too
+low for one), drawn per seed on the counter beside the microwave.
+
+Levels (Table 5): 1 fail to open the door, 2 open it, 3 pick up the food and place it in
+the microwave, 4 close the door, 5 press the start button; milestones
+``open_finish:microwave door``, ``place:food item``, ``close_finish:microwave door``,
+``press:button``. Questions (App. C.3): did the robot open the microwave, pick up / drop
+/ place the food item in the microwave.
+"""
+
+from __future__ import annotations
+
+from rover.sim.kitchen.composites import component_levels
+from rover.sim.kitchen.language import PARAPHRASES
+from rover.sim.kitchen.utensils import ItemRole, item_body
+from rover.sim.levels import by_milestone
+from rover.sim.tasks._common import FINGERS, grasp_subtask, move_subtask, pick_place_qa
+from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
+
+SUITE = "kitchen"
+DOOR = "microwave door"  # the door's name in facts, events, subtasks and questions
+DOOR_CLOSING = "microwave door closed"  # its second worked entry: back to shut
+BUTTON = "button"  # the start button, named as TurnOnMicrowave names it
+FOOD = ItemRole("food item", "food container", "beside fixture", "microwave")
+DOOR_OPEN = 1.6  # rad the door swings to count as open (its range is 0-1.9)
+DOOR_REACH_CLOSED = 0.92  # closed = at most 10% open: 92% of the way back from open
+PRESS_Q = -0.010 / 0.9  # the button's target (as TurnOnMicrowave: past the switching depth)
+
+
+def parts() -> list[dict]:
+    """The microwave's worked parts in order: the door open, the door shut, the button."""
+    return [
+        {"key": DOOR, "part": "door", "facts_as": DOOR, "target": DOOR_OPEN},
+        {
+            "key": DOOR_CLOSING,
+            "part": "door",
+            "facts_as": DOOR,
+            "start_q": DOOR_OPEN,
+            "target": 0.0,
+            "reach": DOOR_REACH_CLOSED,
+            "with_items": True,  # shut on the food (shut at the start is not the end)
+        },
+        {"key": BUTTON, "part": "button", "facts_as": BUTTON, "target": PRESS_Q},
+    ]
+
+
+def _joint_move(name: str, obj: str, point: str, goal: str, key: str, signal: str) -> SubtaskSpec:
+    """A subtask moving a fixture part: progress follows worked entry `key`'s joint."""
+    return SubtaskSpec(
+        name=name,
+        object=obj,
+        robot_points=FINGERS,
+        object_points=[point, point],
+        goal=goal,
+        joint=f"joint:{key}",
+        beta=0.8,
+        end_signal=signal,
+    )
+
+
+def microwave_thawing() -> TaskSpec:
+    """The spec (the expert is `rover.sim.kitchen.thawing_expert`)."""
+    handle = f"{DOOR}:handle"
+    food = FOOD.name
+    subtasks = [
+        SubtaskSpec(
+            name="reach the microwave door's handle",
+            object=DOOR,
+            robot_points=FINGERS,
+            object_points=[handle, handle],
+            end_signal=f"touched:{DOOR}",
+        ),
+        _joint_move(
+            "open the microwave door", DOOR, handle, "goal:door_swung", DOOR, "door_opened:" + DOOR
+        ),
+        grasp_subtask(f"pick up the {food}", food),
+        move_subtask(
+            f"place the {food} in the microwave", food, "goal:microwave", f"placed:{food}"
+        ),
+        _joint_move(
+            "close the microwave door",
+            DOOR,
+            handle,
+            "goal:door_shut",
+            DOOR_CLOSING,
+            f"door_closed:{DOOR}",
+        ),
+        _joint_move(
+            "press the microwave's start button",
+            BUTTON,
+            f"{BUTTON}:top",
+            "goal:button_pressed",
+            BUTTON,
+            f"pressed:{BUTTON}",
+        ),
+    ]
+    milestones = [f"open_finish:{DOOR}", f"place:{food}", f"close_finish:{DOOR}", f"press:{BUTTON}"]
+    levels = component_levels(
+        [
+            "Fail to open the microwave door",
+            "Open the microwave door",
+            "Pick up the food item and place it in the microwave",
+            "Close the microwave door",
+            "Press the microwave start button",
+        ],
+        [2, 2, 1, 1],
+    )
+    qa = [
+        QATemplate(
+            id="did_open",
+            text="Did the robot open the microwave? If so, when?",
+            event="open_finish",
+            object=DOOR,
+        ),
+        *[q for q in pick_place_qa(food, "in the microwave") if q.id != "did_contact"],
+    ]
+    return TaskSpec(
+        name=f"{SUITE}.MicrowaveThawing",
+        env_name="RoverKitchenComposite",
+        suite=SUITE,
+        frames=60,
+        env_kwargs={
+            "fixture": "Microwave",
+            "part": "door",
+            "level_start": True,  # the forward grasp's level-hand ready pose
+            "items": [[FOOD.name, FOOD.category, FOOD.start, FOOD.goal]],
+            "parts": parts(),
+        },
+        description=(
+            "Open the microwave door, put the food item inside, close the door "
+            "and press the start button."
+        ),
+        paraphrases=PARAPHRASES.get("MicrowaveThawing", []),
+        group="microwave_thawing",
+        objects=[
+            ObjectSpec(
+                name=DOOR,
+                body="Microwave_door",
+                centre="Microwave_handle",
+                sites={"handle": "Microwave_handle"},
+                graspable=False,
+            ),
+            ObjectSpec(name=food, body=item_body(FOOD)),
+            ObjectSpec(
+                name=BUTTON,
+                body="Microwave_button",
+                centre="Microwave_top",
+                sites={"top": "Microwave_top"},
+                graspable=False,
+            ),
+        ],
+        goals={
+            "door_swung": GoalSpec(kind="fixture", object=DOOR, body="handle"),
+            "microwave": GoalSpec(kind="body", body="Microwave_interior"),
+            "door_shut": GoalSpec(kind="fixture", object=DOOR_CLOSING, body="handle"),
+            "button_pressed": GoalSpec(kind="fixture", object=BUTTON, body="top"),
+        },
+        subtasks=subtasks,
+        levels=by_milestone(levels, milestones),
+        milestones=milestones,
+        qa_templates=qa,
+        expert="kitchen_thaw",
+        max_expert_steps=1000,
+    )
