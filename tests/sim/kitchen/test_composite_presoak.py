@@ -1,7 +1,5 @@
-"""Kitchen composite PreSoakPan: spec, the pan and its moving region, the articulated switch.
-
-The task is built but not registered yet (its expert is below target), so the spec comes
-from `rover.sim.kitchen.composites.pre_soak_pan` rather than the registry."""
+"""Kitchen composite PreSoakPan: spec, the pan and its moving region, the articulated switch,
+the chained expert's grasp yaw and a whole demonstration."""
 
 from __future__ import annotations
 
@@ -15,12 +13,17 @@ from rover.sim.milestones import level_problems
 
 
 def pre_soak_pan():
-    """The unregistered spec (the task registry is imported first: the composites module
-    is imported by it, and importing it on its own starts a circular import)."""
-    import rover.sim.tasks  # noqa: F401
-    from rover.sim.kitchen.composites import pre_soak_pan as build
+    from rover.sim.tasks import get_task
 
-    return build()
+    return get_task("kitchen.PreSoakPan")
+
+
+def test_registered_in_the_kitchen_suite_and_built_by_composites():
+    from rover.sim.kitchen.composites import pre_soak_pan as build
+    from rover.sim.tasks import task_names
+
+    assert "kitchen.PreSoakPan" in task_names("kitchen")
+    assert pre_soak_pan() == build()
 
 
 BASIN_LENGTH = 0.34  # m: the sink basin's inner length (sink.xml walls at y = +-0.17)
@@ -205,8 +208,12 @@ def test_chained_expert_soaks_the_pan_in_order(presoak):
     from rover.sim.experts import run_expert
     from rover.sim.facts import detect_events, facts_for_states
 
-    demo = run_expert(presoak, 4)
+    # seed 1 once folded the arm lifting the sponge beside the arm's base (wrist joint 6
+    # at its limit at the end, the faucet lever out of reach)
+    demo = run_expert(presoak, 1)
     assert demo.success and len(demo.subtask_ends) == 6
+    presoak.set_state(demo.states[-1])
+    assert presoak.data.qpos[5] < 3.4  # joint 6 (limit 3.75) unfolded
     picks = np.linspace(0, len(demo.states) - 1, 60).round().astype(int)
     facts = facts_for_states(presoak, demo.states[picks], demo.states[np.maximum(picks - 1, 0)])
     assert facts[-1].objects["pan"].inside == "sink"
@@ -223,3 +230,24 @@ def test_chained_expert_soaks_the_pan_in_order(presoak):
         ev[("turn_finish", "sink handle")],
     ]
     assert None not in order and order == sorted(order), order
+
+
+@pytest.mark.sim
+def test_sponge_grasp_turns_from_home_toward_the_wrist_centre_never_past_it(presoak):
+    """Of the sponge's two symmetric grasp yaws the expert takes the one between the start
+    yaw (0, where home leaves the hand) and the yaw that centres the last joint, or the
+    nearest to that range: a grasp a half turn from home rolled the wrist over."""
+    from rover.sim.kitchen.composite_experts import WRIST_START, base_turn, turned_pick
+    from rover.sim.motions import grasp_yaw
+
+    for seed in range(6):
+        presoak.reset(seed)
+        chosen: list[float] = []
+        phases = turned_pick(presoak, "sponge", "goal:pan", np.pi, 0.0, None, chosen).build()
+        taken = phases[0].yaw()
+        assert chosen[0] == taken
+        assert np.sin(taken - grasp_yaw(presoak, "sponge", np.pi)) == pytest.approx(0, abs=1e-9)
+        want = base_turn(presoak, presoak.point("sponge")) + WRIST_START
+        lo, hi = min(0.0, want), max(0.0, want)
+        outside = max(lo - taken, taken - hi, 0.0)
+        assert outside <= (np.pi - (hi - lo)) / 2 + 1e-9, (seed, taken, want)

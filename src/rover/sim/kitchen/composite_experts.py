@@ -3,7 +3,7 @@
 A composite task's expert is its atomic tasks' experts run one after the other, from
 one recorded demonstration: for each (pick up, place) pair of subtasks, back to the
 start pose (after the first), the tabletop top-down pick (`rover.sim.motions`) and the
-carry-and-lower placement. Two things differ from the tabletop pick-and-place script:
+carry-and-lower placement. Where they differ from the tabletop pick-and-place script:
 
 * the grasp height follows the drawn instance: the Panda's fingers are about 5 cm long,
   so an item taller than that grasped at its centre (a 12 cm cucumber standing up)
@@ -11,6 +11,9 @@ carry-and-lower placement. Two things differ from the tabletop pick-and-place sc
   its top instead;
 * the item is lowered to `DROP_DZ` above the goal surface before it is let go, so a
   round item set on the cutting board does not bounce or roll off it;
+* a box set into a pan (the sponge) is let go `BOX_DROP_DZ` above the pan's floor and
+  lowered at `DOWN_GAIN`: lowered fast to the item's own height the hand overshot, the
+  sponge jammed between a finger and the pan's wall, and the hand lifted the pan;
 * an item taken by a handle (the pan) is carried so that its centre, not the hand,
   comes over the goal, at `PAN_CARRY` above it: low enough for the pan's rim to pass
   under the sink spout's nozzle, high enough for its bottom to clear the basin's walls.
@@ -40,6 +43,8 @@ from rover.sim.motions import (
 
 TOP_MARGIN = 0.045  # m below an item's top the fingers close (palm clear of it)
 DROP_DZ = 0.012  # m above the goal surface the item's bottom is let go
+BOX_DROP_DZ = 0.03  # m: a box (a sponge) is let go higher, its fingers clear of the pan
+DOWN_GAIN = 0.6  # lowering gain of a box set into a pan (the tabletop script's is 1.0)
 PAN_CARRY = 0.16  # m above the goal point the hand carries an item held by its handle
 # rad the Panda's last joint starts from the middle of its range (pi/4 of +-2.9): the
 # hand's yaw that leaves it centred is the base joint's turn plus this
@@ -121,7 +126,11 @@ def turned_pick(
     handle taken at -pi/2 ran it into its limit 2.6 cm short of the handle, a sponge
     taken at a yaw far from the carry's left the arm folded against joint 6's limit.
     With `chosen` the carry turns the hand with the base (`carry_turned`), so only the
-    grasp's end counts, and the yaw taken is appended to it."""
+    grasp's end counts, and the yaw taken is appended to it; the grasp then starts from
+    home (yaw 0) and takes the symmetric yaw between 0 and the centred one (or the
+    nearest to that range): the one nearest the centred yaw could be a half turn from
+    home, and turning that far at the sponge rolled the wrist over (joint 5 near 2.4
+    rad, joint 6 at its limit), after which the faucet lever was out of reach."""
 
     def phases() -> list[Phase]:
         out = pick_phases(sim, obj, period, dz, point)
@@ -129,7 +138,12 @@ def turned_pick(
         want = at if chosen is not None else (at + base_turn(sim, sim.point(goal))) / 2
         want += WRIST_START
         yaw = out[0].yaw()
-        best = min((yaw + k * period for k in (-2, -1, 0, 1, 2)), key=lambda y: abs(y - want))
+        options = [yaw + k * period for k in (-2, -1, 0, 1, 2)]
+        if chosen is None:
+            best = min(options, key=lambda y: abs(y - want))
+        else:  # from home (the start yaw, 0): turn toward `want`, never past it
+            lo, hi = min(0.0, want), max(0.0, want)
+            best = min(options, key=lambda y: (max(lo - y, y - hi, 0.0), abs(y - want)))
         out[0].yaw = lambda: best
         if chosen is not None:
             chosen[:] = [best, at]
@@ -171,7 +185,8 @@ def chained_pick_place(sim: SimEnv) -> list[Phase | Retry]:
             continue
         chosen: list[float] = []  # a box (a sponge): the hand turns with the arm's base
         phases.append(turned_pick(sim, obj, move.goal, period, grasp_dz(sim, obj), None, chosen))
-        phases += carry_turned(sim, place_phases(sim, move.goal, DROP_DZ, carry, obj=obj), chosen)
+        placing = place_phases(sim, move.goal, BOX_DROP_DZ, carry, obj=obj)
+        phases += carry_turned(sim, placing, chosen)
     return phases
 
 
@@ -188,6 +203,9 @@ def carry_turned(sim: SimEnv, phases: list[Phase], chosen: list[float]) -> list[
 
     for ph in phases[:4]:  # rise, over, down, let go; the retreat keeps the last yaw
         ph.yaw, ph.track_yaw = yaw, True
+    # lowered at full gain the hand overshot into the pan and, opening there, hooked the
+    # pan's wall and lifted the pan out of the sink
+    phases[2].gain = DOWN_GAIN
     return phases
 
 

@@ -83,9 +83,11 @@ START_SPOTS = {
     "counter far": ((-0.15, -0.07), (-0.27, -0.2)),
     "counter near": ((-0.15, -0.07), (-0.1, -0.06)),
     # PreSoakPan (the sink in reach on the robot's right, y < 0.13 with its footprint):
-    # the pan beside it, the sponge in front of the pan, out of the pan's way
+    # the pan beside it, the sponge in front of the pan's handle, out of the pan's way
+    # and 0.4-0.5 m from the arm's base (at 0.33 m, lifting it folded the elbow against
+    # its limit and the wrist rolled over: the faucet lever was then out of reach)
     "counter beside sink": ((-0.1, -0.05), (0.24, 0.28)),
-    "counter front": ((-0.34, -0.3), (0.18, 0.24)),
+    "counter front": ((-0.3, -0.25), (0.32, 0.38)),
 }
 # spots measured from the fixture in use (x: counter frame; y: from the fixture's +y
 # edge along the counter), for fixtures drawn in a range of places: the forward-grasp
