@@ -71,14 +71,16 @@ class Scripted:
         # rotation about world y applied before the yaw: -pi/2 points the hand forward
         # (+x, fingers closing along y) for the forward grasp into low openings
         self.pitch = 0.0
+        self.roll = 0.0  # rad about the hand's own pointing axis, applied before the pitch
         self.states: list[np.ndarray] = []
         self.actions: list[np.ndarray] = []
 
     def rot_error(self, yaw: float) -> np.ndarray:
         """Axis-angle (world frame) from the current hand orientation to the wanted one."""
         cur = self.sim.data.site_xmat[self.sim._eef_site].reshape(3, 3)
-        if self.pitch:
-            want = Rotation.from_euler("yz", [self.pitch, yaw]).as_matrix() @ self.down
+        if self.pitch:  # (at hand down the pointing axis is world z: roll first)
+            turn = Rotation.from_euler("zyz", [self.roll, self.pitch, yaw])
+            want = turn.as_matrix() @ self.down
         else:
             want = Rotation.from_euler("zx", [yaw, self.tilt]).as_matrix() @ self.down
         return Rotation.from_matrix(want @ cur.T).as_rotvec()
@@ -92,6 +94,8 @@ class Scripted:
     def run(self, phase: Phase) -> None:
         if phase.pitch is not None:
             self.pitch = phase.pitch
+        if phase.roll is not None:
+            self.roll = phase.roll
         yaw = self.yaw0 if phase.yaw is None else phase.yaw()
         self.yaw0 = yaw
         errs: list[tuple[float, float]] = []  # (position error m, orientation error rad)

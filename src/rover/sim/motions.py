@@ -35,6 +35,9 @@ class Phase:
     # a script that points the hand level into the microwave turns it down to press a
     # button on the microwave's top
     pitch: float | None = None
+    # ... and its roll about its own pointing axis (rad, with a pitch; None: keep): a
+    # level hand rolled a quarter turn closes its fingers vertically, across a bar handle
+    roll: float | None = None
 
 
 @dataclass

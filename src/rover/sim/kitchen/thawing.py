@@ -170,5 +170,5 @@ def microwave_thawing() -> TaskSpec:
         milestones=milestones,
         qa_templates=qa,
         expert="kitchen_thaw",
-        max_expert_steps=1000,
+        max_expert_steps=1200,
     )

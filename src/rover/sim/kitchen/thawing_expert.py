@@ -24,6 +24,7 @@ import numpy as np
 from rover.sim.env import SimEnv
 from rover.sim.experts_articulated import latch
 from rover.sim.kitchen.forward_grasp import (
+    FORWARD_PITCH,
     approach_yaw,
     forward_pick,
     forward_place,
@@ -31,17 +32,31 @@ from rover.sim.kitchen.forward_grasp import (
 )
 from rover.sim.motions import CLOSE, OPEN, Phase, Retry
 
-ALONG_BAR = float(-np.pi / 2)  # rad from the door's inward normal to the hand's heading
-# m the grip point sits from the handle's centre toward the door's free edge: the hand,
-# pointing along the bar toward the hinge, has its palm face 4.1 cm behind the grip
-# point, and the bar's end cap reaches 4.05 cm from its centre
-BAR_OUT = 0.008
-BAR_DZ = -0.002  # m: the grip point this far below the bar's centre line
+BAR_ROLL = float(-np.pi / 2)  # rad the level hand rolls: fingers close vertically
+BAR_IN = 0.004  # m past the bar's centre line (toward the door) the grip point goes
+# the share of the door's swing the hand's yaw follows while pulling: turned with it all
+# the way, the arm ran joints 2 and 5 into their limits 0.8 rad into the swing (the
+# grip's pads turn on the bar)
+YAW_MAX = 0.7
 PULL_LEAD = 0.15  # rad along the arc the pull target runs ahead of the door
 PUSH_LEAD = 0.15  # rad ... and the push target while shutting it
-FACE_DOWN = 0.07  # m below the handle the fingertips push the door's face
-FACE_OUT = 0.065  # m out from the handle's centre line to the door's face (bar at 7 cm)
-PRESS_ABOVE = 0.1  # m above the button the hand turns down
+# shutting: the hand's left face (10.4 cm from the grip point, 4-10 cm behind it) pushes
+# the bar while the door stands open past `SIDE_UNTIL`, then the fingertips do
+SIDE_AHEAD = 0.07  # m the grip point stands ahead of the bar (the hand's face beside it)
+SIDE_OFF = 0.112  # m the grip point stands right of the bar
+SIDE_UNTIL = 0.6  # rad
+OVER_DOOR = 0.16  # m above the bar the hand passes over the open door
+# swinging it wide: the door's free edge, inner corner, from the handle's centre (along
+# the door's inward normal, along the door toward the free edge), the hand's right face
+# (10.4 cm right of the grip point) against it at mid height
+EDGE_FROM_HANDLE = (0.08, -0.0825)
+EDGE_DZ = 0.0
+EDGE_AHEAD = 0.07
+EDGE_OFF = 0.112
+PULL_UNTIL = 0.8  # rad the pull by the handle takes the door before the push takes over
+TIP_BACK = 0.018  # m: the grip point this far in front of the bar (fingertips on it)
+PRESS_TILT = 0.35  # rad the hand tilts down from level to press the start button
+TIP_DZ = 0.012  # m above the button's top the grip point presses (the finger's half width)
 
 
 def _inward(yaw: float) -> np.ndarray:
@@ -49,7 +64,9 @@ def _inward(yaw: float) -> np.ndarray:
 
 
 def open_door_phases(sim: SimEnv, key: str) -> list[Phase]:
-    """Grasp the handle's bar from above and carry it along the door's arc."""
+    """Grasp the handle's bar from the front, the level hand rolled a quarter turn so its
+    fingers close vertically across it, and pull it along the door's arc, the hand
+    turning with the door."""
     env = sim.env
     psi = approach_yaw(sim)
 
@@ -57,104 +74,163 @@ def open_door_phases(sim: SimEnv, key: str) -> list[Phase]:
         with env.working(key):
             return env.joint_value()
 
-    def grip_yaw() -> float:  # the hand along the bar, its fingers across it
-        return psi + door_q() + ALONG_BAR
+    def door_yaw() -> float:  # the door's inward normal
+        return psi + door_q()
 
-    def on_bar(p: np.ndarray, q: float) -> np.ndarray:  # toward the door's free edge
-        return p + BAR_OUT * _inward(psi + q + np.pi / 2) + np.array([0.0, 0.0, BAR_DZ])
+    def hand_yaw() -> float:  # the hand turns with the door, up to `YAW_MAX`
+        return psi + min(door_q(), YAW_MAX)
 
     def handle() -> np.ndarray:
-        return on_bar(sim.point("microwave door:handle"), door_q())
+        return sim.point("microwave door:handle") + BAR_IN * _inward(door_yaw())
 
     def ahead() -> np.ndarray:
         with env.working(key):
             q = min(env.joint_value() + PULL_LEAD, env.target + 0.1)
-            return on_bar(env.site_at("handle", q), q)
+            return env.site_at("handle", q) + BAR_IN * _inward(psi + q)
+
+    def done() -> bool:
+        return door_q() >= PULL_UNTIL
+
+    hold = latch(sim)
+    return [
+        Phase(
+            lambda: handle() - 0.1 * _inward(door_yaw()),
+            OPEN,
+            tol=0.012,
+            steps=120,
+            yaw=door_yaw,
+            roll=BAR_ROLL,
+        ),
+        Phase(handle, OPEN, tol=0.006, steps=60, gain=1.2),
+        Phase(hold, CLOSE, tol=None, steps=10),
+        Phase(ahead, CLOSE, tol=None, steps=220, gain=0.8, yaw=hand_yaw, track_yaw=True, done=done),
+    ]
+
+
+def swing_wide_phases(sim: SimEnv, key: str) -> list[Phase]:
+    """Let go of the half-open door, pass over it and push its free edge on round from
+    the inside with the right face of the level, unturned hand, to the target angle."""
+    env = sim.env
+    psi = approach_yaw(sim)
+    fwd = _inward(psi)
+    left = _inward(psi + np.pi / 2)
+
+    def door_q() -> float:
+        with env.working(key):
+            return env.joint_value()
+
+    def edge(q_ahead: float = 0.0) -> np.ndarray:  # the free edge's inner corner
+        with env.working(key):
+            q = min(env.joint_value() + q_ahead, env.target + 0.15)
+            dq = q - env.joint_value()
+        hinge = sim.data.xanchor[env.joint_id].copy()
+        corner = sim.point("microwave door:handle") + EDGE_FROM_HANDLE[0] * _inward(psi + door_q())
+        corner += EDGE_FROM_HANDLE[1] * _inward(psi + door_q() + np.pi / 2)
+        v = corner - hinge
+        c, s_ = np.cos(dq), np.sin(dq)
+        turned = np.array([c * v[0] - s_ * v[1], s_ * v[0] + c * v[1], v[2]])
+        return hinge + turned + np.array([0.0, 0.0, EDGE_DZ])
+
+    def beside(q_ahead: float = 0.0) -> np.ndarray:  # the hand's right face at the edge
+        return edge(q_ahead) + EDGE_AHEAD * fwd + EDGE_OFF * left
 
     def done() -> bool:
         with env.working(key):
             return env.progress() >= 0.97
 
-    hold = latch(sim)
+    rest = latch(sim)
+    over = np.array([0.0, 0.0, OVER_DOOR])
+    turn = lambda: psi  # noqa: E731
     return [
-        Phase(lambda: handle() + [0.0, 0.0, 0.08], OPEN, tol=0.012, steps=120, yaw=grip_yaw),
-        Phase(handle, OPEN, tol=0.006, steps=50, gain=1.2),
-        Phase(hold, CLOSE, tol=None, steps=10),
-        Phase(ahead, CLOSE, tol=None, steps=220, gain=0.8, yaw=grip_yaw, track_yaw=True, done=done),
+        Phase(rest, OPEN, tol=None, steps=8),
+        Phase(lambda: rest() - 0.08 * _inward(psi + door_q()), OPEN, tol=0.02, steps=40),
+        Phase(lambda: rest() - 0.08 * _inward(psi + door_q()) + over, CLOSE, tol=0.02, steps=40),
+        Phase(
+            lambda: beside() + 0.03 * left + over, CLOSE, tol=0.02, steps=100, yaw=turn, roll=0.0
+        ),
+        Phase(lambda: beside() + 0.03 * left, CLOSE, tol=0.015, steps=80),
+        Phase(lambda: beside(PUSH_LEAD), CLOSE, tol=None, steps=160, gain=0.8, done=done),
+        Phase(lambda: beside() + 0.06 * left, CLOSE, tol=0.02, steps=30),
     ]
 
 
-def leave_door_phases(sim: SimEnv, key: str) -> list[Phase]:
-    """Back the fingers out of the handle's gap and rise clear of the bar."""
-    env = sim.env
-    psi = approach_yaw(sim)
-    rest = latch(sim)
-
-    def out() -> np.ndarray:
-        with env.working(key):
-            q = env.joint_value()
-        return rest() - 0.09 * _inward(psi + q) + np.array([0.0, 0.0, 0.02])
-
-    return [Phase(out, CLOSE, tol=0.02, steps=40)]
-
-
 def shut_door_phases(sim: SimEnv, key: str) -> list[Phase]:
-    """Push the door shut from outside: fingertips on its face under the handle."""
+    """Push the door shut from outside by its handle, the hand level and unturned:
+    first with the side of the hand against the bar while the door stands wide (its
+    outer face looks along the counter), then with the fingertips on the bar's front."""
     env = sim.env
     psi = approach_yaw(sim)
+    fwd = _inward(psi)
+    left = _inward(psi + np.pi / 2)
 
-    def door_yaw() -> float:
-        with env.working(key):
-            return psi + env.joint_value()
-
-    def face(q_back: float = 0.0) -> np.ndarray:
+    def bar(q_back: float = 0.0) -> np.ndarray:
         with env.working(key):
             q = max(env.joint_value() - q_back, -0.05)
-            p = env.site_at("handle", q)
-        return p + FACE_OUT * _inward(psi + q) - np.array([0.0, 0.0, FACE_DOWN])
+            return env.site_at("handle", q)
+
+    def door_q() -> float:
+        with env.working(key):
+            return env.joint_value()
+
+    def side(q_back: float = 0.0) -> np.ndarray:  # the hand's left face on the bar
+        return bar(q_back) + SIDE_AHEAD * fwd - SIDE_OFF * left
+
+    def front(q_back: float = 0.0) -> np.ndarray:  # the fingertips on the bar's front
+        return bar(q_back) - TIP_BACK * _inward(psi + door_q())
+
+    def wide() -> bool:
+        return door_q() <= SIDE_UNTIL
 
     def done() -> bool:
         with env.working(key):
             return env.progress() >= 0.98
 
-    stand = lambda: face() - 0.08 * _inward(door_yaw())  # noqa: E731
+    turn = lambda: psi  # noqa: E731
+    start = latch(sim)
+    over = np.array([0.0, 0.0, OVER_DOOR])
     return [
-        Phase(stand, CLOSE, tol=0.015, steps=120, yaw=door_yaw),
-        Phase(lambda: face() - 0.01 * _inward(door_yaw()), CLOSE, tol=0.01, steps=40),
-        Phase(
-            lambda: face(PUSH_LEAD),
-            CLOSE,
-            tol=None,
-            steps=200,
-            gain=0.8,
-            yaw=door_yaw,
-            track_yaw=True,
-            done=done,
-        ),
-        Phase(lambda: face(0.0) - 0.1 * _inward(door_yaw()), CLOSE, tol=0.02, steps=40),
+        # over the open door to its outer side (straight across, the hand swung it wide)
+        Phase(lambda: start() + over, CLOSE, tol=0.02, steps=40, yaw=turn),
+        Phase(lambda: side() - 0.06 * left + over, CLOSE, tol=0.02, steps=100),
+        Phase(lambda: side() - 0.06 * left, CLOSE, tol=0.015, steps=80),
+        Phase(side, CLOSE, tol=0.012, steps=40),
+        Phase(lambda: side(PUSH_LEAD), CLOSE, tol=None, steps=150, gain=0.8, done=wide),
+        Phase(lambda: side() - 0.08 * left - 0.06 * fwd, CLOSE, tol=0.02, steps=40),
+        Phase(lambda: front() - 0.08 * fwd, CLOSE, tol=0.015, steps=60),
+        Phase(front, CLOSE, tol=0.01, steps=40),
+        Phase(lambda: front(PUSH_LEAD), CLOSE, tol=None, steps=150, gain=0.8, done=done),
+        Phase(lambda: front() - 0.1 * fwd, CLOSE, tol=0.02, steps=40),
     ]
 
 
 def press_button_phases(sim: SimEnv, key: str) -> list[Phase]:
-    """Turn the hand down above the start button and press it, held down at the end."""
+    """Press the start button with the fingertips, the hand tilted a little down from
+    level (its palm then clears the microwave's top), held down at the end."""
     env = sim.env
     psi = approach_yaw(sim)
 
     def top() -> np.ndarray:
-        return sim.point("button:top")
+        return sim.point("button:top") + np.array([0.0, 0.0, TIP_DZ])
 
     def pressed_point() -> np.ndarray:
         with env.working(key):
-            return env.site_at("top", env.target * 1.3) + np.array([0.0, 0.0, -0.004])
+            p = env.site_at("top", env.target * 1.3)
+        return p + np.array([0.0, 0.0, TIP_DZ - 0.004])
 
     def reached() -> bool:
         return env.reached_part(key)
 
-    above = np.array([0.0, 0.0, PRESS_ABOVE])
+    tilt = FORWARD_PITCH + PRESS_TILT
     return [
-        Phase(lambda: top() + above, CLOSE, tol=0.02, steps=80, yaw=lambda: psi),
-        Phase(lambda: top() + above, CLOSE, tol=0.015, steps=80, pitch=0.0),
-        Phase(lambda: top() + np.array([0, 0, 0.01]), CLOSE, tol=0.006, steps=50, gain=1.2),
+        Phase(
+            lambda: top() + [0.0, 0.0, 0.08],
+            CLOSE,
+            tol=0.015,
+            steps=100,
+            yaw=lambda: psi,
+            pitch=tilt,
+        ),
+        Phase(lambda: top() + [0.0, 0.0, 0.01], CLOSE, tol=0.006, steps=50, gain=1.2),
         Phase(pressed_point, CLOSE, tol=None, steps=40, gain=0.5, done=reached),
         Phase(pressed_point, CLOSE, tol=None, steps=6, gain=0.5),  # hold it down
     ]
@@ -171,13 +247,11 @@ def thawing_script(sim: SimEnv) -> list[Phase | Retry]:
     food = subs[2].object
     goal = subs[3].goal
     role = env.role(food)
-    home = latch(sim)
+    home = sim.point("eef")  # the ready pose's grip point (the script is built at reset)
     return [
         *open_door_phases(sim, door_key),
-        *leave_door_phases(sim, door_key),
-        Phase(
-            lambda: home() + np.array([0.0, 0.0, 0.03]), OPEN, tol=0.03, steps=80, yaw=lambda: psi
-        ),
+        *swing_wide_phases(sim, door_key),
+        Phase(lambda: home + np.array([0.0, 0.0, 0.03]), OPEN, tol=0.03, steps=80, yaw=lambda: psi),
         forward_pick(sim, food, psi, region_floor_z("counter")),
         *forward_place(
             sim,
