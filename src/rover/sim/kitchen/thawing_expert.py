@@ -53,6 +53,7 @@ EDGE_FROM_HANDLE = (0.08, -0.0825)
 EDGE_DZ = 0.0
 EDGE_AHEAD = 0.07
 EDGE_OFF = 0.112
+CLEAR_AHEAD = np.array([0.12, 0.0, 0.05])  # m from the ready pose's grip point
 PULL_UNTIL = 0.8  # rad the pull by the handle takes the door before the push takes over
 TIP_BACK = 0.018  # m: the grip point this far in front of the bar (fingertips on it)
 PRESS_TILT = 0.35  # rad the hand tilts down from level to press the start button
@@ -251,7 +252,10 @@ def thawing_script(sim: SimEnv) -> list[Phase | Retry]:
     return [
         *open_door_phases(sim, door_key),
         *swing_wide_phases(sim, door_key),
-        Phase(lambda: home + np.array([0.0, 0.0, 0.03]), OPEN, tol=0.03, steps=80, yaw=lambda: psi),
+        # out ahead of the ready pose first: pushing the door wide folds the arm toward
+        # its pedestal (link 6 touches it), and straight home it stayed folded
+        Phase(lambda: home + CLEAR_AHEAD, OPEN, tol=0.03, steps=50, yaw=lambda: psi),
+        Phase(lambda: home + np.array([0.0, 0.0, 0.03]), OPEN, tol=0.03, steps=60),
         forward_pick(sim, food, psi, region_floor_z("counter")),
         *forward_place(
             sim,
