@@ -97,9 +97,11 @@ BESIDE_SPOTS = {
     # CoffeeSetupMug's counter spot (`regions.COUNTER_X`, `regions.COUNTER_GAP`)
     "beside fixture": ((-0.14, -0.05), (0.09, 0.15)),
     # two items one behind the other: the front one is taken first, so the hand never
-    # reaches past an item to get the other
-    "beside fixture front": ((-0.17, -0.13), (0.09, 0.14)),
-    "beside fixture back": ((-0.06, -0.03), (0.09, 0.14)),
+    # reaches past an item to get the other (nearer the robot than x -0.13 the level
+    # hand's stand-off point is out of reach: it stopped 10 cm high, came down on the
+    # item and pushed it away)
+    "beside fixture front": ((-0.13, -0.1), (0.09, 0.14)),
+    "beside fixture back": ((-0.03, -0.01), (0.09, 0.14)),
 }
 # the start yaw range of an item per spot (default: any): the pan's handle points along
 # the counter, away from the sink, so it stays along the basin's length when set in it
