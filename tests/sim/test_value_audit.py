@@ -39,3 +39,19 @@ def test_a_button_clicking_between_two_frames_is_not_a_lag():
     assert joint_lags(_facts(click, "button"), progress) == []
     two = [0.0] * 27 + [0.5, 1.0, 1.0]
     assert joint_lags(_facts(two, "button"), progress)
+
+
+def test_the_gain_asked_scales_with_the_turns_share_of_a_longer_task():
+    """The lever's turn is the last of six subtasks in PreSoakPan: progress follows it
+    from 0.85 to 1.0 (its whole share is about 1/6), which is no lag there, but would
+    be one in an atomic two-subtask task, whose turn carries half the progress."""
+    turn = [0.0, 0.0, 0.08, 0.34, 0.6, 0.85, 0.95, 0.95]
+    late = [0.8, 0.83, 0.85, 0.89, 0.94, 0.98, 1.0, 1.0]
+    assert joint_lags(_facts(turn, "sink handle"), late, subtasks=6) == []
+    (why,) = joint_lags(_facts(turn, "sink handle"), late)
+    assert "< 0.25" in why
+    # progress flat while the lever turns, rising only after (at the release) stays a
+    # lag however many subtasks the task has
+    flat = [0.8, 0.83, 0.83, 0.83, 0.83, 0.835, 0.84, 1.0]
+    (why,) = joint_lags(_facts(turn, "sink handle"), flat, subtasks=6)
+    assert "< 0.08" in why

@@ -18,7 +18,8 @@ LEGEND = (
     "episodes whose events agree with the facts; teleports: episodes where an untouched "
     "object rises > 2 cm between frames; final progress: mean per level (must not fall); "
     "stalls: episodes with > 3 still expert frames in a row; joint: episodes whose "
-    "progress gains < 0.25 while an articulated part moves to its goal; tries: mean/max "
+    "progress gains < 0.25 (x 2/n in a task of n > 2 subtasks) while an articulated part "
+    "moves to its goal; tries: mean/max "
     "per episode"
 )
 

@@ -25,7 +25,11 @@ STILL_PROGRESS = 0.01  # progress change per frame below which progress is flat 
 STILL_POS = 0.005  # ... and no hand or object moves more than this (m) ...
 STILL_GRIP = 0.02  # ... nor does the gripper open or close more than this
 ORDER_TOLERANCE = 1e-6  # mean final progress may not fall from one level to the next
-JOINT_GAIN = 0.25  # progress an articulated part must add while it moves start -> goal
+# progress an articulated part must add while it moves start -> goal, in a task of
+# `JOINT_SUBTASKS` subtasks (an atomic fixture task: grasp or reach, then turn or press);
+# a task of n subtasks needs JOINT_GAIN * JOINT_SUBTASKS / n (`joint_gain_needed`)
+JOINT_GAIN = 0.25
+JOINT_SUBTASKS = 2
 JOINT_START, JOINT_FINISH = 0.1, 0.9  # the part's fraction of the way: "moving" between
 
 
@@ -98,11 +102,24 @@ def facts_changed(a: FrameFacts, b: FrameFacts) -> bool:
     return any(abs(v - a.articulations.get(k, v)) > STILL_GRIP for k, v in b.articulations.items())
 
 
-def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
+def joint_gain_needed(subtasks: int) -> float:
+    """Progress a part's motion must earn in a task of `subtasks` subtasks.
+
+    Progress is shared among the subtasks, so the part's subtask carries about 1/n of
+    it: in an atomic fixture task (two subtasks) the turn must earn `JOINT_GAIN`, half
+    of its share; in a composite whose sixth subtask turns the faucet lever, the whole
+    turn is worth about 1/6 and half of that is asked (PreSoakPan's turn earns 0.15)."""
+    return JOINT_GAIN * JOINT_SUBTASKS / max(subtasks, JOINT_SUBTASKS)
+
+
+def joint_lags(
+    facts: list[FrameFacts], progress: list[float], subtasks: int = JOINT_SUBTASKS
+) -> list[str]:
     """Articulated parts that go from their start to their goal while progress gains less
-    than `JOINT_GAIN`: progress must follow the joint (a knob's turn, a door's swing), not
-    jump when the hand lets go. The way toward the goal is read from the first frame (a
-    part starting above half way, an open drawer to close, is measured by 1 - fraction);
+    than `joint_gain_needed` for a task of `subtasks` subtasks: progress must follow the
+    joint (a knob's turn, a door's swing), not jump when the hand lets go. The way
+    toward the goal is read from the first frame (a part starting above half way, an
+    open drawer to close, is measured by 1 - fraction);
     the gain is taken from the last frame at most `JOINT_START` of the way to the first
     frame at least `JOINT_FINISH` of it. A part that goes the whole way between two
     consecutive frames (a button's click) is skipped: there is no motion in the video for
@@ -111,6 +128,7 @@ def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
     out = []
     if not facts or len(progress) != len(facts):
         return out
+    need = joint_gain_needed(subtasks)
     for name, first in facts[0].articulations.items():
         way = [
             (1.0 - v if first > 0.5 else v)
@@ -123,9 +141,9 @@ def joint_lags(facts: list[FrameFacts], progress: list[float]) -> list[str]:
         if start is None or done - start < 2:
             continue  # (a part that clicks between two sampled frames has no way to follow)
         gain = progress[done] - progress[start]
-        if gain < JOINT_GAIN:
+        if gain < need:
             out.append(
-                f"progress gains {gain:.2f} < {JOINT_GAIN} while the {name} moves to its goal "
+                f"progress gains {gain:.2f} < {need:.2f} while the {name} moves to its goal "
                 f"(frames {start}-{done})"
             )
     return out
@@ -153,16 +171,30 @@ def expert_stalls(episode: Episode) -> list[str]:
     return out
 
 
-def _components(episode: Episode) -> list[str] | None:
+def _spec(episode: Episode):
+    """The rover task an episode was generated from; None for any other dataset."""
     task = episode.extra.get("sim_task")
     if not task:
         return None
     from rover.sim.tasks import get_task
 
     try:
-        return get_task(task).milestones
+        return get_task(task)
     except Exception:  # noqa: BLE001 - a dataset from another rover version: skip the check
         return None
+
+
+def _components(episode: Episode) -> list[str] | None:
+    spec = _spec(episode)
+    return None if spec is None else spec.milestones
+
+
+def _subtask_count(episode: Episode) -> int:
+    """Subtasks of the episode's task: its spec's, else the ones its truth lists."""
+    spec = _spec(episode)
+    if spec is not None:
+        return len(spec.subtasks)
+    return len(episode.truth.subtasks) if episode.truth is not None else JOINT_SUBTASKS
 
 
 def audit(episodes: Iterable[Episode]) -> list[TaskAudit]:
@@ -200,7 +232,7 @@ def audit(episodes: Iterable[Episode]) -> list[TaskAudit]:
         if rises:
             ta.untouched_moved += 1
             ta.problems += [f"{ep.id}: {p}" for p in rises]
-        lags = joint_lags(facts, list(truth.progress))
+        lags = joint_lags(facts, list(truth.progress), _subtask_count(ep))
         if lags:
             ta.joint_lags += 1
             ta.problems += [f"{ep.id}: {p}" for p in lags]
