@@ -124,6 +124,7 @@ def _set(sim, part: str, q: float) -> None:
 @pytest.mark.sim
 def test_door_and_button_facts_predicates_and_goals_come_from_their_own_joints(sim):
     from rover.sim.facts import frame_facts
+    from rover.sim.kitchen.thawing import DOOR_OPEN
 
     env = sim.env
     sim.reset(0)
@@ -134,7 +135,7 @@ def test_door_and_button_facts_predicates_and_goals_come_from_their_own_joints(s
     assert not sim.predicate(f"door_opened:{DOOR}") and not sim.predicate("pressed:button")
     handle_at_open = sim.point("goal:door_swung")
     top_pressed = sim.point("goal:button_pressed")
-    _set(sim, "door", 1.6)
+    _set(sim, "door", DOOR_OPEN)
     f = frame_facts(sim)
     assert f.articulations == {DOOR: 1.0, "button": 0.0} and f.pressed == []
     assert sim.predicate(f"door_opened:{DOOR}") and not sim.predicate("pressed:button")
@@ -159,6 +160,4 @@ def test_door_and_button_facts_predicates_and_goals_come_from_their_own_joints(s
     assert sim.predicate(f"door_closed:{DOOR}") and not sim.predicate(f"door_opened:{DOOR}")
     assert sim.point("joint:microwave door closed")[0] == pytest.approx(1.0)
     # after the working() switches, the env's joint is the first part's again
-    from rover.sim.kitchen.thawing import DOOR_OPEN
-
     assert env.part == DOOR and env.kind == "door" and env.target == pytest.approx(DOOR_OPEN)
