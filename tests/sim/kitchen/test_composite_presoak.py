@@ -253,3 +253,20 @@ def test_sponge_grasp_turns_from_home_toward_the_wrist_centre_never_past_it(pres
         lo, hi = min(0.0, want), max(0.0, want)
         outside = max(lo - taken, taken - hi, 0.0)
         assert outside <= (np.pi - (hi - lo)) / 2 + 1e-9, (seed, taken, want)
+
+
+@pytest.mark.sim
+def test_lever_turn_is_retried_until_the_lever_is_turned(presoak):
+    from rover.sim.kitchen.composite_experts import chained_pick_place
+    from rover.sim.motions import Retry
+
+    env = presoak.env
+    presoak.reset(0)
+    last = chained_pick_place(presoak)[-1]
+    assert isinstance(last, Retry) and last.tries > 1
+    assert not last.check()  # the lever untouched: another try
+    fresh = last.build()
+    assert fresh and fresh is not last.build()  # each try built anew
+    env.sim.data.qpos[env.joint_qpos_addr] = env.target
+    env.sim.forward()
+    assert last.check()

@@ -19,12 +19,14 @@ carry-and-lower placement. Where they differ from the tabletop pick-and-place sc
   under the sink spout's nozzle, high enough for its bottom to clear the basin's walls.
 
 A pair of subtasks on a fixture part (grasp the sink handle, turn it) is the faucet
-task's own expert (`rover.sim.kitchen.experts.turn_script`), after going home.
+task's own expert (`rover.sim.kitchen.experts.turn_script`), after going home, run again
+(up to three tries in all) while the part is not turned.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 
@@ -168,8 +170,9 @@ def chained_pick_place(sim: SimEnv) -> list[Phase | Retry]:
             # left it where the next grasp's turn ran joint 6 into its limit
             unwind = (lambda: 0.0) if turned else None
             phases.append(Phase(lambda: home, OPEN, tol=0.03, steps=60, yaw=unwind))
-        if not sim.spec.object_spec(obj).graspable:  # the fixture part the task works
-            phases += turn_script(sim)
+        if not sim.spec.object_spec(obj).graspable:  # the fixture part the task works:
+            # the dial expert, tried again from above the part if the part is not turned
+            phases.append(Retry(lambda: turn_script(sim), partial(sim.predicate, f"turned:{obj}")))
             continue
         point = grasp.object_points[0] if grasp.object_points[0] != obj else None
         turned = point is not None or grasp_period(sim, obj) is not None
