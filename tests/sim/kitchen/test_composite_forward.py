@@ -12,6 +12,16 @@ from rover.sim.kitchen.forward_items import item_instances
 from rover.sim.milestones import level_problems
 from rover.sim.tasks import get_task
 
+
+def prepare_coffee():
+    """PrepareCoffee is built but not registered (its expert is below target): the spec
+    from its builder, the registry imported first (it imports the composite modules)."""
+    import rover.sim.tasks  # noqa: F401
+    from rover.sim.kitchen.forward_composites import prepare_coffee as build
+
+    return build()
+
+
 PANTRY = ("first pantry item", "second pantry item")
 
 
@@ -45,7 +55,7 @@ def test_restock_pantry_has_table5_levels_app_n_subtasks_and_c3_questions():
 
 
 def test_prepare_coffee_has_table5_levels_app_n_subtasks_and_c3_questions():
-    spec = get_task("kitchen.PrepareCoffee")
+    spec = prepare_coffee()
     assert spec.frames == 60 and spec.group == "prepare_coffee"
     assert [s.end_signal for s in spec.subtasks] == [
         "lifted:mug",
@@ -70,7 +80,7 @@ def test_prepare_coffee_has_table5_levels_app_n_subtasks_and_c3_questions():
 
 
 def test_coffee_levels_are_components_every_earlier_one_achieved():
-    spec = get_task("kitchen.PrepareCoffee")
+    spec = prepare_coffee()
     ms = spec.milestones
 
     def f(mug=None, held=None, button=0.0) -> FrameFacts:
@@ -126,10 +136,13 @@ def test_pantry_items_come_from_the_forward_table_and_stand_beside_the_cabinet(s
 
 
 @pytest.mark.sim
-def test_coffee_button_is_the_scenes_joint_and_success_needs_both(sim_env):
+def test_coffee_button_is_the_scenes_joint_and_success_needs_both():
     from rover.sim.facts import frame_facts
 
-    sim = sim_env("kitchen.PrepareCoffee")
+    pytest.importorskip("robosuite")
+    from rover.sim.env import SimEnv
+
+    sim = SimEnv(prepare_coffee())
     env = sim.env
     sim.reset(0)
     assert env.part == "button" and frame_facts(sim).articulations == {"button": 0.0}

@@ -5,7 +5,7 @@ counter and `forward_grasp.forward_place` into the goal region (both with the ha
 pointing into the fixture in use), then back to the level-hand start point before the
 next pair (the hand stays level: robosuite's hand-down start cannot be turned level at
 counter height, `forward_grasp`'s docstring). A (reach, press) pair on the fixture's
-button is `press_phases`: the closed, level hand pressed down on it.
+button is `press_phases`: the closed hand, turned half-way down, presses it.
 
 Registered as ``kitchen_forward_chain``; `rover.sim.experts` runs it with the forward
 grasp's pitch (the hand level) like ``kitchen_forward``.
@@ -18,6 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from rover.sim.env import SimEnv
+from rover.sim.experts_articulated import latch
 from rover.sim.kitchen.forward_grasp import (
     approach_yaw,
     forward_pick,
@@ -27,18 +28,22 @@ from rover.sim.kitchen.forward_grasp import (
 from rover.sim.kitchen.regions import OPENINGS
 from rover.sim.motions import CLOSE, OPEN, Phase, Retry
 
-PRESS_ABOVE = 0.08  # m above the button's top the hand turns down (fingers closed)
-PRESS_PITCH = -0.8  # rad
+PRESS_ABOVE = 0.08  # m above the button's top the fingertips line up
+# the hand's pitch while pressing (rad about world y: -pi/2 level, 0 pointing down),
+# half-way down: the fingertips are its lowest point. Level, the palm's underside met
+# the machine's head before the button was 1 cm down (and the fingers, which the touch
+# and press facts read, never touched it); turned fully down above the button, joint 6
+# reached its limit and the hand stopped 13 cm short; at -1.0 the fingertips slid off
+PRESS_PITCH = -0.8
+# rad added to the fixture's yaw while pressing (a round button: the yaw is free); at the
+# fixture's own yaw wrist joint 7 reached its limit on the way up in 2 of 8 seeds
+PRESS_YAW = -0.3
 
 
 def press_phases(sim: SimEnv, yaw: float) -> list[Phase]:
-    """Turn the closed hand down above the button (`Phase.pitch` 0: the hand-down frame)
-    and press it past its switching depth with the fingertips, as the button task's
-    expert does; held down at the end (a spring button rises again when let go).
-
-    Pressed with the level hand the palm's underside meets the machine's head before
-    the button is 1 cm down, and the fingers, which the touch and press facts read,
-    never reach it."""
+    """Rise straight up turning the closed hand half-way down (`Phase.pitch`), come over
+    the button and press it past its switching depth with the fingertips, as the button
+    task's expert does; held down at the end (a spring button rises again when let go)."""
     fx = sim.env
 
     def top() -> np.ndarray:
@@ -48,9 +53,14 @@ def press_phases(sim: SimEnv, yaw: float) -> list[Phase]:
         return fx.site_at("top", fx.target * 1.3) + np.array([0.0, 0.0, -0.004])
 
     above = np.array([0.0, 0.0, PRESS_ABOVE])
+    start = latch(sim)
+
+    def raised() -> np.ndarray:  # straight up from where the hand is, to the button's height
+        return np.array([*start()[:2], top()[2] + PRESS_ABOVE])
+
     return [
-        Phase(lambda: top() + above, CLOSE, tol=0.02, steps=80, yaw=lambda: yaw),
-        Phase(lambda: top() + above, CLOSE, tol=0.015, steps=80, pitch=PRESS_PITCH),
+        Phase(raised, CLOSE, tol=0.02, steps=80, yaw=lambda: yaw + PRESS_YAW, pitch=PRESS_PITCH),
+        Phase(lambda: top() + above, CLOSE, tol=0.012, steps=100),
         Phase(lambda: top() + np.array([0, 0, 0.01]), CLOSE, tol=0.006, steps=50, gain=1.2),
         Phase(pressed, CLOSE, tol=None, steps=40, gain=0.5, done=fx.reached),
         Phase(pressed, CLOSE, tol=None, steps=6, gain=0.5),  # hold it down

@@ -1,7 +1,8 @@
 """The composite kitchen tasks whose items go behind an opening (paper Tables 4 and 5).
 
-RestockPantry puts two pantry items from the counter into the cabinet, PrepareCoffee
-puts the mug under the coffee machine's spout and presses the machine's start button.
+RestockPantry puts two pantry items from the counter into the cabinet (registered),
+PrepareCoffee puts the mug under the coffee machine's spout and presses the machine's
+start button (built, not registered: its expert succeeds on 15 of 20 seeds).
 Both carry their items with the forward (level-hand) grasp of
 `rover.sim.kitchen.forward_grasp` (the cabinet's compartment is 15 cm high, the gap under
 the spout 21 cm: the top-down hand does not fit), so the arm starts in its level-hand
@@ -189,4 +190,6 @@ def prepare_coffee() -> TaskSpec:
     )
 
 
-TASKS: list[TaskSpec] = [restock_pantry(), prepare_coffee()]
+# PrepareCoffee is built but not registered: its chained expert succeeds on 15 of 20
+# seeds (the target is 18), see docs/kitchen.md's composite section
+TASKS: list[TaskSpec] = [restock_pantry()]

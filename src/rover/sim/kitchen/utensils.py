@@ -94,8 +94,12 @@ START_SPOTS = {
 # composites (RestockPantry, PrepareCoffee) take items from beside the cabinet or the
 # coffee machine, on its +y side as the pick-and-place tasks do (`regions.COUNTER_SIDE`)
 BESIDE_SPOTS = {
-    # CoffeeSetupMug's counter spot (`regions.COUNTER_X`, `regions.COUNTER_GAP`)
-    "beside fixture": ((-0.14, -0.05), (0.09, 0.15)),
+    # beside the coffee machine at CoffeeSetupMug's gap (`regions.COUNTER_GAP`), further
+    # from the robot than its `regions.COUNTER_X`: with the spot 10-14 cm in front of the
+    # counter's centre line the level hand's stand-off point, 13 cm nearer the robot
+    # still, was out of reach (joint 4 near its limit) and the hand came down on the mug
+    # and pushed it away (PrepareCoffee seeds 5 and 14 of 20)
+    "beside fixture": ((-0.08, -0.03), (0.09, 0.15)),
     # two items one behind the other: the front one is taken first, so the hand never
     # reaches past an item to get the other (nearer the robot than x -0.13 the level
     # hand's stand-off point is out of reach: it stopped 10 cm high, came down on the
