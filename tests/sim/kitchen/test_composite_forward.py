@@ -14,12 +14,7 @@ from rover.sim.tasks import get_task
 
 
 def prepare_coffee():
-    """PrepareCoffee is built but not registered (its expert is below target): the spec
-    from its builder, the registry imported first (it imports the composite modules)."""
-    import rover.sim.tasks  # noqa: F401
-    from rover.sim.kitchen.forward_composites import prepare_coffee as build
-
-    return build()
+    return get_task("kitchen.PrepareCoffee")
 
 
 PANTRY = ("first pantry item", "second pantry item")
@@ -136,13 +131,10 @@ def test_pantry_items_come_from_the_forward_table_and_stand_beside_the_cabinet(s
 
 
 @pytest.mark.sim
-def test_coffee_button_is_the_scenes_joint_and_success_needs_both():
+def test_coffee_button_is_the_scenes_joint_and_success_needs_both(sim_env):
     from rover.sim.facts import frame_facts
 
-    pytest.importorskip("robosuite")
-    from rover.sim.env import SimEnv
-
-    sim = SimEnv(prepare_coffee())
+    sim = sim_env("kitchen.PrepareCoffee")
     env = sim.env
     sim.reset(0)
     assert env.part == "button" and frame_facts(sim).articulations == {"button": 0.0}

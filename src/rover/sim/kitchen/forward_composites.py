@@ -1,8 +1,7 @@
 """The composite kitchen tasks whose items go behind an opening (paper Tables 4 and 5).
 
-RestockPantry puts two pantry items from the counter into the cabinet (registered),
-PrepareCoffee puts the mug under the coffee machine's spout and presses the machine's
-start button (built, not registered: its expert succeeds on 15 of 20 seeds).
+RestockPantry puts two pantry items from the counter into the cabinet, PrepareCoffee
+puts the mug under the coffee machine's spout and presses the machine's start button.
 Both carry their items with the forward (level-hand) grasp of
 `rover.sim.kitchen.forward_grasp` (the cabinet's compartment is 15 cm high, the gap under
 the spout 21 cm: the top-down hand does not fit), so the arm starts in its level-hand
