@@ -114,8 +114,10 @@ def test_pantry_items_come_from_the_forward_table_and_stand_beside_the_cabinet(s
         cab = env.scene.layout["Cabinet"]
         for role, obj in zip(PANTRY, objs, strict=True):
             assert env.object_place(role) == ("on", "counter")
-            shown = env.role_geoms[role].ids[obj["name"]]
-            assert all(env.sim.model._model.geom_contype[g] for g in shown)
+            m, geoms = env.sim.model._model, env.role_geoms[role].ids
+            assert any(m.geom_contype[g] for g in geoms[obj["name"]])  # the drawn one collides
+            hidden = [g for name, gs in geoms.items() if name != obj["name"] for g in gs]
+            assert hidden and not any(m.geom_contype[g] for g in hidden)  # the others do not
             edge_gaps.append(obj["qpos"][1] - cab.y - FIXTURES["Cabinet"].half_width)
         assert objs[0]["qpos"][0] < objs[1]["qpos"][0] - 0.05  # the first stands in front
         door = env.sim.data.qpos[env.joint_qpos_addr]
