@@ -36,7 +36,7 @@ FAIL_TO_PICK = {
 }
 
 
-def _pick_and_place(
+def pick_and_place(
     role: ItemRole, where: str, goal: str, point: str | None = None
 ) -> list[SubtaskSpec]:
     """Pick up an item and place it: `point` is where the hand takes it (a pan by its
@@ -69,6 +69,17 @@ def component_levels(names: list[str], subtasks_per_component: list[int]) -> lis
     ]
 
 
+def pick_first_levels(
+    names: list[str], subtasks_per_component: list[int], milestones: list[str]
+) -> list[LevelSpec]:
+    """Table 5's levels of a composite whose first component picks an item up: cut by
+    milestone between the demo's components, level 1 (fail to pick up the first item)
+    leaving the expert early on its way there (`FAIL_TO_PICK`)."""
+    levels = by_milestone(component_levels(names, subtasks_per_component), milestones)
+    levels[0] = levels[0].model_copy(update=FAIL_TO_PICK)
+    return levels
+
+
 def _spec(name: str, **fields) -> TaskSpec:
     return TaskSpec(
         name=f"{SUITE}.{name}",
@@ -94,19 +105,18 @@ def arrange_vegetables() -> TaskSpec:
     goals: dict[str, GoalSpec] = {}
     for k, (role, spot) in enumerate(zip(roles, spots, strict=True), start=1):
         goals[f"board_{k}"] = GoalSpec(kind="body", body=spot)
-        subtasks += _pick_and_place(role, on_board, f"goal:board_{k}")
+        subtasks += pick_and_place(role, on_board, f"goal:board_{k}")
         qa += [q for q in pick_place_qa(role.name, on_board) if q.id != "did_contact"]
     milestones = [f"place:{r.name}" for r in roles]
-    levels = component_levels(
+    levels = pick_first_levels(
         [
             "Fail to pick up the first vegetable",
             "Pick up the first vegetable and place it on the cutting board",
             "Pick up the second vegetable and place it on the cutting board",
         ],
         [2, 2],
+        milestones,
     )
-    levels = by_milestone(levels, milestones)
-    levels[0] = levels[0].model_copy(update=FAIL_TO_PICK)
     return _spec(
         "ArrangeVegetables",
         env_kwargs={
@@ -192,15 +202,15 @@ def pre_soak_pan() -> TaskSpec:
     handle, turned, handle_subtasks, handle_qa = _sink_handle()
     pan_sites = {k: site_name(pan.prefix, k) for k in (HANDLE_SITE, INSIDE_SITE)}
     subtasks = [
-        *_pick_and_place(pan, "in the sink", "goal:sink", point=f"pan:{HANDLE_SITE}"),
-        *_pick_and_place(sponge, "in the pan", "goal:pan"),
+        *pick_and_place(pan, "in the sink", "goal:sink", point=f"pan:{HANDLE_SITE}"),
+        *pick_and_place(sponge, "in the pan", "goal:pan"),
         *handle_subtasks,
     ]
     qa = [q for q in pick_place_qa("pan", "in the sink") if q.id != "did_contact"]
     qa += [q for q in pick_place_qa("sponge", "in the pan") if q.id != "did_contact"]
     qa += handle_qa
     milestones = ["place:pan", "place:sponge", "turn_finish:sink handle"]
-    levels = component_levels(
+    levels = pick_first_levels(
         [  # Table 5 numbers these 1, 2, 2, 4: four levels
             "Fail to pick up the pan",
             "Pick up the pan and place it in the sink",
@@ -208,9 +218,8 @@ def pre_soak_pan() -> TaskSpec:
             "Turn the sink handle to turn on the sink",
         ],
         [2, 2, 2],
+        milestones,
     )
-    levels = by_milestone(levels, milestones)
-    levels[0] = levels[0].model_copy(update=FAIL_TO_PICK)
     return _spec(
         "PreSoakPan",
         env_kwargs={

@@ -9,19 +9,19 @@ ready pose (``level_start``) and the expert is `rover.sim.kitchen.forward_chain`
 
 As in `rover.sim.kitchen.composites`: the subtasks (App. N) are the chained atomic
 tasks' in order, the levels Table 5's row for the group, one component each
-(`component_levels`, cut between the demo's components by `by_milestone`), and level 1
-leaves the expert early on its way to the first item (`FAIL_TO_PICK`). Items are named by
+(`pick_first_levels`: cut between the demo's components by milestone, level 1
+leaving the expert early on its way to the first item). Items are named by
 role ("the first pantry item"); the drawn instances (a bean can, a jam jar, ...) are
 recorded in ``episode.json`` under ``extra.scene.objects``.
 """
 
 from __future__ import annotations
 
-from rover.sim.kitchen.composites import FAIL_TO_PICK, component_levels
+from rover.sim.kitchen.composites import pick_and_place, pick_first_levels
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
-from rover.sim.levels import by_milestone
-from rover.sim.tasks._common import FINGERS, grasp_subtask, move_subtask, pick_place_qa
+from rover.sim.part_travel import BUTTON_TARGET
+from rover.sim.tasks._common import FINGERS, pick_place_qa
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"
@@ -32,7 +32,6 @@ CABINET_OPEN = 1.7  # rad the cabinet door stands open (as PickPlaceCounterToCab
 # leave the hand no room beside the first; the first goes to the back, the second in front
 BACK_SPOT = (0.035, 0.0, 0.0)
 FRONT_SPOT = (-0.045, 0.0, 0.0)
-PRESS_Q = -0.010  # m: the button's switching depth (rover.sim.fixtures.button.PRESS_Q)
 
 
 def _spec(name: str, **fields) -> TaskSpec:
@@ -45,13 +44,6 @@ def _spec(name: str, **fields) -> TaskSpec:
         expert="kitchen_forward_chain",
         **fields,
     )
-
-
-def _pick_and_place(role: ItemRole, where: str, goal: str) -> list[SubtaskSpec]:
-    return [
-        grasp_subtask(f"pick up the {role.name}", role.name),
-        move_subtask(f"place the {role.name} {where}", role.name, goal, f"placed:{role.name}"),
-    ]
 
 
 def _qa(role: ItemRole, where: str) -> list[QATemplate]:
@@ -71,20 +63,19 @@ def restock_pantry() -> TaskSpec:
         "cabinet_front": GoalSpec(kind="body", body="Cabinet_inside", offset=FRONT_SPOT),
     }
     subtasks = [
-        *_pick_and_place(roles[0], where, "goal:cabinet_back"),
-        *_pick_and_place(roles[1], where, "goal:cabinet_front"),
+        *pick_and_place(roles[0], where, "goal:cabinet_back"),
+        *pick_and_place(roles[1], where, "goal:cabinet_front"),
     ]
     milestones = [f"place:{r.name}" for r in roles]
-    levels = component_levels(
+    levels = pick_first_levels(
         [
             "Fail to pick up the first item",
             "Pick up the first item and place it in the pantry",
             "Pick up the second item and place it in the pantry",
         ],
         [2, 2],
+        milestones,
     )
-    levels = by_milestone(levels, milestones)
-    levels[0] = levels[0].model_copy(update=FAIL_TO_PICK)
     return _spec(
         "RestockPantry",
         env_kwargs={
@@ -151,22 +142,21 @@ def prepare_coffee() -> TaskSpec:
     mug = ItemRole("mug", "mug", "beside fixture", "coffee machine")
     button, button_subtasks, press_q = _start_button()
     milestones = ["place:mug", "press:button"]
-    levels = component_levels(
+    levels = pick_first_levels(
         [
             "Fail to pick up the mug",
             "Pick up the mug and place it in the coffee machine",
             "Press the start button on the coffee machine",
         ],
         [2, 2],
+        milestones,
     )
-    levels = by_milestone(levels, milestones)
-    levels[0] = levels[0].model_copy(update=FAIL_TO_PICK)
     return _spec(
         "PrepareCoffee",
         env_kwargs={
             "fixture": "Coffee",
             "part": "button",
-            "target": PRESS_Q / 0.9,  # as CoffeePressButton
+            "target": BUTTON_TARGET,  # as CoffeePressButton
             "articulated": True,
             "level_start": True,
             "items": [[mug.name, mug.category, mug.start, mug.goal]],
@@ -181,7 +171,7 @@ def prepare_coffee() -> TaskSpec:
             "slot": GoalSpec(kind="body", body="Coffee_slot"),
             "button_pressed": GoalSpec(kind="fixture", object="button", body="top"),
         },
-        subtasks=[*_pick_and_place(mug, where, "goal:slot"), *button_subtasks],
+        subtasks=[*pick_and_place(mug, where, "goal:slot"), *button_subtasks],
         levels=levels,
         milestones=milestones,
         qa_templates=[*_qa(mug, where), press_q],

@@ -18,14 +18,12 @@ from rover.sim.kitchen.forward_composites import TASKS as FORWARD_COMPOSITE_TASK
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
 from rover.sim.levels import by_milestone
+from rover.sim.part_travel import BUTTON_TARGET, DRAWER_OPEN_Q, DRAWER_START_OPEN
 from rover.sim.tasks._common import FINGERS, door_opening_levels, named_levels
 from rover.sim.tasks.articulated import drawer_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"
-DRAWER_OPEN_Q = 0.12  # mirrors rover.sim.fixtures.drawer.OPEN_Q (no robosuite import here)
-DRAWER_START_OPEN = 0.14  # ... and START_OPEN
-PRESS_Q = -0.010  # ... rover.sim.fixtures.button.PRESS_Q
 QUARTER = float(np.pi / 2)
 DOOR_OPEN = 1.2  # rad a cabinet door swings to count as open
 SPOUT_TURN = 0.8  # rad the sink spout swivels
@@ -151,7 +149,7 @@ def _close_single_door() -> TaskSpec:
 def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
     return _spec(
         name,
-        env_kwargs={"fixture": fixture, "part": "button", "target": PRESS_Q / 0.9},
+        env_kwargs={"fixture": fixture, "part": "button", "target": BUTTON_TARGET},
         description=f"Press the start button of the {appliance} to turn it on.",
         group="appliances",
         objects=[_part("button", fixture, "button", "top", top="top")],
@@ -200,7 +198,7 @@ TURN_OFF_MICROWAVE = _spec(
         "fixture": "Microwave",
         "part": "stop",
         "facts_as": "stop button",
-        "target": PRESS_Q / 0.9,
+        "target": BUTTON_TARGET,
     },
     description="Press the stop button of the microwave to turn it off.",
     group="appliances",

@@ -24,6 +24,7 @@ from rover.sim.kitchen.composites import component_levels
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
 from rover.sim.levels import by_milestone
+from rover.sim.part_travel import BUTTON_TARGET
 from rover.sim.tasks._common import FINGERS, grasp_subtask, move_subtask, pick_place_qa
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
@@ -36,7 +37,6 @@ FOOD = ItemRole("food item", "food container", "beside fixture", "microwave")
 # level hand carrying the food passes it into the cavity
 DOOR_OPEN = 1.35
 DOOR_REACH_CLOSED = 0.92  # closed = at most 10% open: 92% of the way back from open
-PRESS_Q = -0.010 / 0.9  # the button's target (as TurnOnMicrowave: past the switching depth)
 
 
 def parts() -> list[dict]:
@@ -52,7 +52,7 @@ def parts() -> list[dict]:
             "reach": DOOR_REACH_CLOSED,
             "with_items": True,  # shut on the food (shut at the start is not the end)
         },
-        {"key": BUTTON, "part": "button", "facts_as": BUTTON, "target": PRESS_Q},
+        {"key": BUTTON, "part": "button", "facts_as": BUTTON, "target": BUTTON_TARGET},
     ]
 
 

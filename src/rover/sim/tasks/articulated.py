@@ -12,10 +12,9 @@ from __future__ import annotations
 from typing import Any
 
 from rover.sim.levels import by_milestone
+from rover.sim.part_travel import DRAWER_START_OPEN
 from rover.sim.tasks._common import FINGERS, named_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
-
-DRAWER_START_OPEN = 0.14  # m; mirrors rover.sim.fixtures.drawer.START_OPEN (no robosuite here)
 
 _DRAWER = ObjectSpec(
     name="drawer",
