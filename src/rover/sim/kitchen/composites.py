@@ -22,7 +22,13 @@ from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pan import HANDLE_SITE, INSIDE_SITE, PAN_REGION, site_name
 from rover.sim.kitchen.utensils import BOARD_REGION, ItemRole, item_body
 from rover.sim.levels import ENDINGS_BY_KIND, LevelSpec, by_milestone, default_levels
-from rover.sim.tasks._common import FINGERS, grasp_subtask, move_subtask, pick_place_qa
+from rover.sim.tasks._common import (
+    FINGERS,
+    grasp_subtask,
+    joint_subtask,
+    move_subtask,
+    pick_place_qa,
+)
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"
@@ -167,15 +173,8 @@ def _sink_handle() -> tuple[ObjectSpec, GoalSpec, list[SubtaskSpec], list[QATemp
             object_points=[obj, obj],
             end_signal=f"grasped:{obj}",
         ),
-        SubtaskSpec(
-            name="turn the sink handle",
-            object=obj,
-            robot_points=FINGERS,
-            object_points=[f"{obj}:tip", f"{obj}:tip"],
-            goal="goal:knob_turned",
-            joint=f"joint:{obj}",  # progress follows the lever's joint toward its target
-            beta=0.8,
-            end_signal=f"turned:{obj}",
+        joint_subtask(
+            "turn the sink handle", obj, f"{obj}:tip", "goal:knob_turned", f"turned:{obj}"
         ),
     ]
     qa = [

@@ -21,7 +21,7 @@ from rover.sim.kitchen.composites import pick_and_place, pick_first_levels
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
 from rover.sim.part_travel import BUTTON_TARGET
-from rover.sim.tasks._common import FINGERS, pick_place_qa
+from rover.sim.tasks._common import FINGERS, joint_subtask, pick_place_qa
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"
@@ -116,15 +116,8 @@ def _start_button() -> tuple[ObjectSpec, list[SubtaskSpec], QATemplate]:
             object_points=[f"{obj}:top", f"{obj}:top"],
             end_signal=f"touched:{obj}",
         ),
-        SubtaskSpec(
-            name="press the button down",
-            object=obj,
-            robot_points=FINGERS,
-            object_points=[f"{obj}:top", f"{obj}:top"],
-            goal="goal:button_pressed",
-            joint=f"joint:{obj}",
-            beta=0.8,
-            end_signal=f"pressed:{obj}",
+        joint_subtask(
+            "press the button down", obj, f"{obj}:top", "goal:button_pressed", f"pressed:{obj}"
         ),
     ]
     qa = QATemplate(

@@ -19,7 +19,7 @@ from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
 from rover.sim.levels import by_milestone
 from rover.sim.part_travel import BUTTON_TARGET, DRAWER_OPEN_Q, DRAWER_START_OPEN
-from rover.sim.tasks._common import FINGERS, door_opening_levels, named_levels
+from rover.sim.tasks._common import FINGERS, door_opening_levels, joint_subtask, named_levels
 from rover.sim.tasks.articulated import drawer_protocol
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
@@ -50,19 +50,6 @@ def _spec(name: str, **fields) -> TaskSpec:
         suite=SUITE,
         paraphrases=PARAPHRASES.get(name, []),
         **fields,
-    )
-
-
-def _move(name: str, obj: str, point: str, goal: str, signal: str) -> SubtaskSpec:
-    return SubtaskSpec(
-        name=name,
-        object=obj,
-        robot_points=FINGERS,
-        object_points=[point, point],
-        goal=goal,
-        joint=f"joint:{obj}",  # progress follows the part's joint toward its target
-        beta=0.8,
-        end_signal=signal,
     )
 
 
@@ -97,7 +84,9 @@ OPEN_SINGLE_DOOR = _spec(
     goals={"door_swung": GoalSpec(kind="fixture", object="door", body="handle")},
     subtasks=[
         _reach("grasp the door handle", "door", "door:handle", "grasped:door"),
-        _move("swing the door open", "door", "door:handle", "goal:door_swung", "turned:door"),
+        joint_subtask(
+            "swing the door open", "door", "door:handle", "goal:door_swung", "turned:door"
+        ),
     ],
     levels=door_opening_levels(),
     milestones=["approach:door", "contact:door", "open_start:door", "open_finish:door"],
@@ -158,7 +147,7 @@ def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
             _reach(
                 f"reach the {appliance}'s start button", "button", "button:top", "touched:button"
             ),
-            _move(
+            joint_subtask(
                 "press the button down",
                 "button",
                 "button:top",
@@ -211,7 +200,7 @@ TURN_OFF_MICROWAVE = _spec(
             "stop button:top",
             "touched:stop button",
         ),
-        _move(
+        joint_subtask(
             "press the stop button down",
             "stop button",
             "stop button:top",
@@ -289,7 +278,9 @@ def _dial(
         goals={"knob_turned": GoalSpec(kind="fixture", object=obj, body=tip)},
         subtasks=[
             _reach(f"grasp the {part_words}", obj, obj, f"grasped:{obj}"),
-            _move(f"turn the {part_words}", obj, f"{obj}:tip", "goal:knob_turned", f"turned:{obj}"),
+            joint_subtask(
+                f"turn the {part_words}", obj, f"{obj}:tip", "goal:knob_turned", f"turned:{obj}"
+            ),
         ],
         levels=_early_start(
             [[f"Approach the {part_words}"], [f"Start turning the {part_words}"]],

@@ -25,7 +25,13 @@ from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
 from rover.sim.levels import by_milestone
 from rover.sim.part_travel import BUTTON_TARGET
-from rover.sim.tasks._common import FINGERS, grasp_subtask, move_subtask, pick_place_qa
+from rover.sim.tasks._common import (
+    FINGERS,
+    grasp_subtask,
+    joint_subtask,
+    move_subtask,
+    pick_place_qa,
+)
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"
@@ -56,20 +62,6 @@ def parts() -> list[dict]:
     ]
 
 
-def _joint_move(name: str, obj: str, point: str, goal: str, key: str, signal: str) -> SubtaskSpec:
-    """A subtask moving a fixture part: progress follows worked entry `key`'s joint."""
-    return SubtaskSpec(
-        name=name,
-        object=obj,
-        robot_points=FINGERS,
-        object_points=[point, point],
-        goal=goal,
-        joint=f"joint:{key}",
-        beta=0.8,
-        end_signal=signal,
-    )
-
-
 def microwave_thawing() -> TaskSpec:
     """The spec (the expert is `rover.sim.kitchen.thawing_expert`)."""
     handle = f"{DOOR}:handle"
@@ -82,27 +74,26 @@ def microwave_thawing() -> TaskSpec:
             object_points=[handle, handle],
             end_signal=f"touched:{DOOR}",
         ),
-        _joint_move(
-            "open the microwave door", DOOR, handle, "goal:door_swung", DOOR, "door_opened:" + DOOR
+        joint_subtask(
+            "open the microwave door", DOOR, handle, "goal:door_swung", f"door_opened:{DOOR}"
         ),
         grasp_subtask(f"pick up the {food}", food),
         move_subtask(
             f"place the {food} in the microwave", food, "goal:microwave", f"placed:{food}"
         ),
-        _joint_move(
+        joint_subtask(
             "close the microwave door",
             DOOR,
             handle,
             "goal:door_shut",
-            DOOR_CLOSING,
             f"door_closed:{DOOR}",
+            key=DOOR_CLOSING,
         ),
-        _joint_move(
+        joint_subtask(
             "press the microwave's start button",
             BUTTON,
             f"{BUTTON}:top",
             "goal:button_pressed",
-            BUTTON,
             f"pressed:{BUTTON}",
         ),
     ]

@@ -31,6 +31,24 @@ def move_subtask(
     )
 
 
+def joint_subtask(
+    name: str, obj: str, point: str, goal: str, signal: str, key: str | None = None
+) -> SubtaskSpec:
+    """Move a fixture part to its target by `point` (a handle, a lever's tip, a button's
+    top): the goal term follows the joint ``joint:<key>`` (the part's own, or worked
+    entry `key` of an env that works several parts) toward the target."""
+    return SubtaskSpec(
+        name=name,
+        object=obj,
+        robot_points=FINGERS,
+        object_points=[point, point],
+        goal=goal,
+        joint=f"joint:{key or obj}",
+        beta=0.8,
+        end_signal=signal,
+    )
+
+
 def named_levels(milestones: Sequence[Sequence[str]], names: Sequence[str]) -> list[LevelSpec]:
     """B's default Table-5 levels, relabelled with this task's wording."""
     levels = default_levels(milestones)

@@ -13,7 +13,7 @@ from typing import Any
 
 from rover.sim.levels import by_milestone
 from rover.sim.part_travel import DRAWER_START_OPEN
-from rover.sim.tasks._common import FINGERS, named_levels
+from rover.sim.tasks._common import FINGERS, joint_subtask, named_levels
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 _DRAWER = ObjectSpec(
@@ -50,15 +50,12 @@ def drawer_protocol(closing: bool, part: str = "drawer") -> dict[str, Any]:
                 object_points=[f"{part}:handle", f"{part}:handle"],
                 end_signal=f"grasped:{part}",
             ),
-            SubtaskSpec(
-                name=f"{push} the {part} {end}",
-                object=part,
-                robot_points=FINGERS,
-                object_points=[f"{part}:handle", f"{part}:handle"],
-                goal=f"goal:{part}_{verb}",
-                joint=f"joint:{part}",
-                beta=0.8,
-                end_signal=f"{signal}:{part}",
+            joint_subtask(
+                f"{push} the {part} {end}",
+                part,
+                f"{part}:handle",
+                f"goal:{part}_{verb}",
+                f"{signal}:{part}",
             ),
         ],
         "levels": named_levels(
