@@ -18,16 +18,17 @@ tomato, a carrot, ...) change with the seed and are recorded in ``episode.json``
 
 from __future__ import annotations
 
+from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pan import HANDLE_SITE, INSIDE_SITE, PAN_REGION, site_name
 from rover.sim.kitchen.utensils import BOARD_REGION, ItemRole, item_body
 from rover.sim.levels import ENDINGS_BY_KIND, LevelSpec, by_milestone, default_levels
 from rover.sim.tasks._common import (
-    FINGERS,
     grasp_subtask,
     joint_subtask,
     move_subtask,
     pick_place_qa,
+    touch_subtask,
 )
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
@@ -157,22 +158,10 @@ def _sink_handle() -> tuple[ObjectSpec, GoalSpec, list[SubtaskSpec], list[QATemp
     """The faucet lever as TurnOnSinkFaucet has it: the part, its goal (the lever's tip
     with the joint at a quarter turn), its two subtasks and App. C.3's two questions."""
     obj = "sink handle"
-    part = ObjectSpec(
-        name=obj,
-        body="Sink_knob",
-        centre="Sink_centre",
-        sites={"tip": "Sink_handle_tip"},
-        graspable=False,
-    )
+    part = part_spec(obj, "Sink", "knob", "centre", tip="handle_tip")
     goal = GoalSpec(kind="fixture", object=obj, body="handle_tip")
     subtasks = [
-        SubtaskSpec(
-            name="grasp the sink handle",
-            object=obj,
-            robot_points=FINGERS,
-            object_points=[obj, obj],
-            end_signal=f"grasped:{obj}",
-        ),
+        touch_subtask("grasp the sink handle", obj, obj, f"grasped:{obj}"),
         joint_subtask(
             "turn the sink handle", obj, f"{obj}:tip", "goal:knob_turned", f"turned:{obj}"
         ),

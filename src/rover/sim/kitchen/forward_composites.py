@@ -18,10 +18,11 @@ recorded in ``episode.json`` under ``extra.scene.objects``.
 from __future__ import annotations
 
 from rover.sim.kitchen.composites import pick_and_place, pick_first_levels
+from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
 from rover.sim.part_travel import BUTTON_TARGET
-from rover.sim.tasks._common import FINGERS, joint_subtask, pick_place_qa
+from rover.sim.tasks._common import joint_subtask, pick_place_qa, touch_subtask
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"
@@ -101,20 +102,10 @@ def _start_button() -> tuple[ObjectSpec, list[SubtaskSpec], QATemplate]:
     """The coffee machine's start button as CoffeePressButton has it: the part, its two
     subtasks (reach it, press it down; progress follows its joint) and App. C.3's question."""
     obj = "button"
-    part = ObjectSpec(
-        name=obj,
-        body="Coffee_button",
-        centre="Coffee_top",
-        sites={"top": "Coffee_top"},
-        graspable=False,
-    )
+    part = part_spec(obj, "Coffee", "button", "top", top="top")
     subtasks = [
-        SubtaskSpec(
-            name="reach the coffee machine's start button",
-            object=obj,
-            robot_points=FINGERS,
-            object_points=[f"{obj}:top", f"{obj}:top"],
-            end_signal=f"touched:{obj}",
+        touch_subtask(
+            "reach the coffee machine's start button", obj, f"{obj}:top", f"touched:{obj}"
         ),
         joint_subtask(
             "press the button down", obj, f"{obj}:top", "goal:button_pressed", f"pressed:{obj}"

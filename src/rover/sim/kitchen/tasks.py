@@ -14,29 +14,25 @@ from __future__ import annotations
 import numpy as np
 
 from rover.sim.kitchen.composites import TASKS as COMPOSITE_TASKS
+from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.forward_composites import TASKS as FORWARD_COMPOSITE_TASKS
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
 from rover.sim.levels import by_milestone
 from rover.sim.part_travel import BUTTON_TARGET, DRAWER_OPEN_Q, DRAWER_START_OPEN
-from rover.sim.tasks._common import FINGERS, door_opening_levels, joint_subtask, named_levels
+from rover.sim.tasks._common import (
+    door_opening_levels,
+    joint_subtask,
+    named_levels,
+    touch_subtask,
+)
 from rover.sim.tasks.articulated import drawer_protocol
-from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
+from rover.sim.tasks.base import GoalSpec, QATemplate, TaskSpec
 
 SUITE = "kitchen"
 QUARTER = float(np.pi / 2)
 DOOR_OPEN = 1.2  # rad a cabinet door swings to count as open
 SPOUT_TURN = 0.8  # rad the sink spout swivels
-
-
-def _part(name: str, fixture: str, body: str, centre: str, **sites: str) -> ObjectSpec:
-    return ObjectSpec(
-        name=name,
-        body=f"{fixture}_{body}",
-        centre=f"{fixture}_{centre}",
-        sites={k: f"{fixture}_{v}" for k, v in sites.items()},
-        graspable=False,
-    )
 
 
 def _qa(obj: str, items: list[tuple[str, str, str]]) -> list[QATemplate]:
@@ -53,12 +49,6 @@ def _spec(name: str, **fields) -> TaskSpec:
     )
 
 
-def _reach(name: str, obj: str, point: str, signal: str) -> SubtaskSpec:
-    return SubtaskSpec(
-        name=name, object=obj, robot_points=FINGERS, object_points=[point, point], end_signal=signal
-    )
-
-
 # --------------------------------------------------------------- doors/drawers
 def _drawer(closing: bool) -> TaskSpec:
     kwargs = {"fixture": "Drawer", "part": "drawer"}
@@ -70,7 +60,7 @@ def _drawer(closing: bool) -> TaskSpec:
         "CloseDrawer" if closing else "OpenDrawer",
         env_kwargs=kwargs,
         group="doors_drawers",
-        objects=[_part("drawer", "Drawer", "drawer", "centre", handle="handle")],
+        objects=[part_spec("drawer", "Drawer", "drawer", "centre", handle="handle")],
         **drawer_protocol(closing),
     )
 
@@ -80,10 +70,10 @@ OPEN_SINGLE_DOOR = _spec(
     env_kwargs={"fixture": "Cabinet", "part": "door", "target": DOOR_OPEN},
     description="Grasp the cabinet door's handle and swing the door open.",
     group="doors_drawers",
-    objects=[_part("door", "Cabinet", "door", "centre", handle="handle")],
+    objects=[part_spec("door", "Cabinet", "door", "centre", handle="handle")],
     goals={"door_swung": GoalSpec(kind="fixture", object="door", body="handle")},
     subtasks=[
-        _reach("grasp the door handle", "door", "door:handle", "grasped:door"),
+        touch_subtask("grasp the door handle", "door", "door:handle", "grasped:door"),
         joint_subtask(
             "swing the door open", "door", "door:handle", "goal:door_swung", "turned:door"
         ),
@@ -129,7 +119,7 @@ def _close_single_door() -> TaskSpec:
             "reach": 0.92,
         },
         group="doors_drawers",
-        objects=[_part("door", "Cabinet", "door", "centre", handle="handle")],
+        objects=[part_spec("door", "Cabinet", "door", "centre", handle="handle")],
         **proto,
     )
 
@@ -141,10 +131,10 @@ def _button(name: str, fixture: str, appliance: str) -> TaskSpec:
         env_kwargs={"fixture": fixture, "part": "button", "target": BUTTON_TARGET},
         description=f"Press the start button of the {appliance} to turn it on.",
         group="appliances",
-        objects=[_part("button", fixture, "button", "top", top="top")],
+        objects=[part_spec("button", fixture, "button", "top", top="top")],
         goals={"button_pressed": GoalSpec(kind="fixture", object="button", body="top")},
         subtasks=[
-            _reach(
+            touch_subtask(
                 f"reach the {appliance}'s start button", "button", "button:top", "touched:button"
             ),
             joint_subtask(
@@ -191,10 +181,10 @@ TURN_OFF_MICROWAVE = _spec(
     },
     description="Press the stop button of the microwave to turn it off.",
     group="appliances",
-    objects=[_part("stop button", "Microwave", "stop", "stop_top", top="stop_top")],
+    objects=[part_spec("stop button", "Microwave", "stop", "stop_top", top="stop_top")],
     goals={"button_pressed": GoalSpec(kind="fixture", object="stop button", body="stop_top")},
     subtasks=[
-        _reach(
+        touch_subtask(
             "reach the microwave's stop button",
             "stop button",
             "stop button:top",
@@ -274,10 +264,10 @@ def _dial(
         env_kwargs=kwargs,
         description=f"Grasp the {part_words} and {what}.",
         group="fixtures_knobs",
-        objects=[_part(obj, fixture, body, centre, tip=tip)],
+        objects=[part_spec(obj, fixture, body, centre, tip=tip)],
         goals={"knob_turned": GoalSpec(kind="fixture", object=obj, body=tip)},
         subtasks=[
-            _reach(f"grasp the {part_words}", obj, obj, f"grasped:{obj}"),
+            touch_subtask(f"grasp the {part_words}", obj, obj, f"grasped:{obj}"),
             joint_subtask(
                 f"turn the {part_words}", obj, f"{obj}:tip", "goal:knob_turned", f"turned:{obj}"
             ),

@@ -21,18 +21,19 @@ the microwave, 4 close the door, 5 press the start button; milestones
 from __future__ import annotations
 
 from rover.sim.kitchen.composites import component_levels
+from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
 from rover.sim.levels import by_milestone
 from rover.sim.part_travel import BUTTON_TARGET
 from rover.sim.tasks._common import (
-    FINGERS,
     grasp_subtask,
     joint_subtask,
     move_subtask,
     pick_place_qa,
+    touch_subtask,
 )
-from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
+from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, TaskSpec
 
 SUITE = "kitchen"
 DOOR = "microwave door"  # the door's name in facts, events, subtasks and questions
@@ -67,13 +68,7 @@ def microwave_thawing() -> TaskSpec:
     handle = f"{DOOR}:handle"
     food = FOOD.name
     subtasks = [
-        SubtaskSpec(
-            name="reach the microwave door's handle",
-            object=DOOR,
-            robot_points=FINGERS,
-            object_points=[handle, handle],
-            end_signal=f"touched:{DOOR}",
-        ),
+        touch_subtask("reach the microwave door's handle", DOOR, handle, f"touched:{DOOR}"),
         joint_subtask(
             "open the microwave door", DOOR, handle, "goal:door_swung", f"door_opened:{DOOR}"
         ),
@@ -136,21 +131,9 @@ def microwave_thawing() -> TaskSpec:
         paraphrases=PARAPHRASES.get("MicrowaveThawing", []),
         group="microwave_thawing",
         objects=[
-            ObjectSpec(
-                name=DOOR,
-                body="Microwave_door",
-                centre="Microwave_handle",
-                sites={"handle": "Microwave_handle"},
-                graspable=False,
-            ),
+            part_spec(DOOR, "Microwave", "door", "handle", handle="handle"),
             ObjectSpec(name=food, body=item_body(FOOD)),
-            ObjectSpec(
-                name=BUTTON,
-                body="Microwave_button",
-                centre="Microwave_top",
-                sites={"top": "Microwave_top"},
-                graspable=False,
-            ),
+            part_spec(BUTTON, "Microwave", "button", "top", top="top"),
         ],
         goals={
             "door_swung": GoalSpec(kind="fixture", object=DOOR, body="handle"),

@@ -31,6 +31,14 @@ def move_subtask(
     )
 
 
+def touch_subtask(name: str, obj: str, point: str, signal: str) -> SubtaskSpec:
+    """Bring both fingers to a fixture part's `point` (no goal term): "grasp the door
+    handle", "reach the start button"."""
+    return SubtaskSpec(
+        name=name, object=obj, robot_points=FINGERS, object_points=[point, point], end_signal=signal
+    )
+
+
 def joint_subtask(
     name: str, obj: str, point: str, goal: str, signal: str, key: str | None = None
 ) -> SubtaskSpec:
