@@ -18,7 +18,6 @@ tomato, a carrot, ...) change with the seed and are recorded in ``episode.json``
 
 from __future__ import annotations
 
-from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pan import HANDLE_SITE, INSIDE_SITE, PAN_REGION, site_name
 from rover.sim.kitchen.utensils import BOARD_REGION, ItemRole, item_body
@@ -27,6 +26,7 @@ from rover.sim.tasks._common import (
     grasp_subtask,
     joint_subtask,
     move_subtask,
+    part_spec,
     pick_place_qa,
     touch_subtask,
 )

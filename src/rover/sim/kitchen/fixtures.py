@@ -12,8 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from rover.sim.tasks.base import ObjectSpec
-
 HERE = Path(__file__).resolve().parent
 ASSETS = HERE / "assets"
 TABLETOP_FIXTURES = HERE.parent / "fixtures"
@@ -21,18 +19,6 @@ TABLETOP_FIXTURES = HERE.parent / "fixtures"
 COUNTER_SIZE = (0.8, 2.4, 0.05)  # m: the counter box (depth along x, length along y, top)
 COUNTER_TOP = 0.8  # m: counter top height
 SLOTS = (-1.0, -0.62, 0.62, 1.0)  # m along the counter (y) for the fixtures not in use
-
-
-def part_spec(name: str, fixture: str, body: str, centre: str, **sites: str) -> ObjectSpec:
-    """The task object of a fixture part (not graspable), its bodies and sites named by the
-    fixture's MuJoCo prefix: ``part_spec("button", "Coffee", "button", "top", top="top")``."""
-    return ObjectSpec(
-        name=name,
-        body=f"{fixture}_{body}",
-        centre=f"{fixture}_{centre}",
-        sites={k: f"{fixture}_{v}" for k, v in sites.items()},
-        graspable=False,
-    )
 
 
 @dataclass(frozen=True)

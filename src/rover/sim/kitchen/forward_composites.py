@@ -18,11 +18,10 @@ recorded in ``episode.json`` under ``extra.scene.objects``.
 from __future__ import annotations
 
 from rover.sim.kitchen.composites import pick_and_place, pick_first_levels
-from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
 from rover.sim.part_travel import BUTTON_TARGET
-from rover.sim.tasks._common import joint_subtask, pick_place_qa, touch_subtask
+from rover.sim.tasks._common import joint_subtask, part_spec, pick_place_qa, touch_subtask
 from rover.sim.tasks.base import GoalSpec, ObjectSpec, QATemplate, SubtaskSpec, TaskSpec
 
 SUITE = "kitchen"

@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 
 from rover.sim.kitchen.composites import TASKS as COMPOSITE_TASKS
-from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.forward_composites import TASKS as FORWARD_COMPOSITE_TASKS
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
@@ -24,6 +23,7 @@ from rover.sim.tasks._common import (
     door_opening_levels,
     joint_subtask,
     named_levels,
+    part_spec,
     touch_subtask,
 )
 from rover.sim.tasks.articulated import drawer_protocol

@@ -21,7 +21,6 @@ the microwave, 4 close the door, 5 press the start button; milestones
 from __future__ import annotations
 
 from rover.sim.kitchen.composites import component_levels
-from rover.sim.kitchen.fixtures import part_spec
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.utensils import ItemRole, item_body
 from rover.sim.levels import by_milestone
@@ -30,6 +29,7 @@ from rover.sim.tasks._common import (
     grasp_subtask,
     joint_subtask,
     move_subtask,
+    part_spec,
     pick_place_qa,
     touch_subtask,
 )

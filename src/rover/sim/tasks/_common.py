@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from rover.sim.levels import LevelSpec, by_milestone, default_levels
-from rover.sim.tasks.base import QATemplate, SubtaskSpec
+from rover.sim.tasks.base import ObjectSpec, QATemplate, SubtaskSpec
 
 FINGERS = ["left_finger", "right_finger"]
 
@@ -28,6 +28,18 @@ def move_subtask(
         goal=goal,
         beta=beta,
         end_signal=signal,
+    )
+
+
+def part_spec(name: str, fixture: str, body: str, centre: str, **sites: str) -> ObjectSpec:
+    """The task object of a fixture part (not graspable), its bodies and sites named by the
+    fixture's MuJoCo prefix: ``part_spec("button", "Coffee", "button", "top", top="top")``."""
+    return ObjectSpec(
+        name=name,
+        body=f"{fixture}_{body}",
+        centre=f"{fixture}_{centre}",
+        sites={k: f"{fixture}_{v}" for k, v in sites.items()},
+        graspable=False,
     )
 
 
