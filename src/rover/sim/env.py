@@ -265,7 +265,14 @@ class SimEnv:
         )
 
     def _final_signals(self) -> list[str]:
-        return [s.end_signal for s in self.spec.subtasks if s.end_signal.startswith("placed:")]
+        """Earlier subtasks whose result must still hold at the end: an item placed, a
+        door shut (MicrowaveThawing shuts the door before pressing start; a door pulled
+        ajar again on the way to the button is not a finished task)."""
+        return [
+            s.end_signal
+            for s in self.spec.subtasks
+            if s.end_signal.startswith(("placed:", "door_closed:"))
+        ]
 
     # ------------------------------------------------------------------ goals
     def goal(self, name: str) -> np.ndarray:

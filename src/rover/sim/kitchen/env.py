@@ -82,6 +82,13 @@ class RoverKitchen(FixtureEnv):
         level_start: start the Panda in the level-hand ready pose of the forward grasp
             (`rover.sim.kitchen.forward_grasp.READY_Q`); None: when the item's start or
             goal region lies behind a fixture's opening.
+        yaw_range: the task's own range for the fixture's yaw (rad), inside the
+            fixture's (`Fixture.yaw_range`); None: the fixture's. MicrowaveThawing turns
+            the microwave only one way: turned the other, the opening door swings toward
+            the arm's base and folds the arm onto its pedestal.
+        decor_clear: a band of counter y (m) no décor stands in: the arm's path around
+            the fixture (MicrowaveThawing's hand goes round the open door's outer side,
+            where a cereal box on a décor spot blocked its wrist). None: every spot.
         **kwargs: the usual `ManipulationEnv` arguments.
     """
 
@@ -96,10 +103,17 @@ class RoverKitchen(FixtureEnv):
         start: str = "counter",
         goal: str = "counter",
         level_start: bool | None = None,
+        yaw_range: tuple[float, float] | list[float] | None = None,
+        decor_clear: tuple[float, float] | list[float] | None = None,
         **kwargs,
     ) -> None:
         if fixture not in FIXTURES or part not in FIXTURES[fixture].joints:
             raise ValueError(f"kitchen fixture {fixture!r} has no part {part!r}")
+        own = FIXTURES[fixture].yaw_range
+        if yaw_range is not None and not own[0] <= yaw_range[0] < yaw_range[1] <= own[1]:
+            raise ValueError(f"{fixture} yaw range {yaw_range} is not inside {own}")
+        self.yaw_ranges = {} if yaw_range is None else {fixture: tuple(yaw_range)}
+        self.decor_clear = None if decor_clear is None else tuple(decor_clear)
         self.fixture_name = fixture
         self.kind = part  # the fixture's own part name (the experts read this)
         self.part = "" if item else (facts_as or part)
@@ -247,7 +261,8 @@ class RoverKitchen(FixtureEnv):
     # ---------------------------------------------------------------- reset
     def _reset_internal(self) -> None:
         ManipulationEnv._reset_internal(self)
-        self.scene = draw_scene(self.rng, self.used, draw_decor(self.rng))
+        decor = draw_decor(self.rng, self.decor_clear)
+        self.scene = draw_scene(self.rng, self.used, decor, self.yaw_ranges)
         if self.item is not None:
             self.scene.item = draw_item(self.rng, self)
         self.apply_scene(self.scene)

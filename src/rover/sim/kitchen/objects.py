@@ -68,16 +68,20 @@ def instances(category: str) -> list[Instance]:
     return found
 
 
-def draw_decor(rng: np.random.Generator) -> list[dict]:
-    """`DECOR_COUNT` instances of different categories on distinct spots, colours jittered."""
-    cats = rng.permutation(len(CATEGORIES))[:DECOR_COUNT]
-    spots = rng.permutation(len(DECOR_SPOTS))[:DECOR_COUNT]
+def draw_decor(rng: np.random.Generator, clear: tuple[float, float] | None = None) -> list[dict]:
+    """`DECOR_COUNT` instances of different categories on distinct spots, colours jittered;
+    none on a spot whose y lies in the band `clear` (the arm's path around a fixture),
+    fewer when fewer spots are left."""
+    free = [xy for xy in DECOR_SPOTS if clear is None or not clear[0] <= xy[1] <= clear[1]]
+    count = min(DECOR_COUNT, len(free))
+    cats = rng.permutation(len(CATEGORIES))[:count]
+    spots = rng.permutation(len(free))[:count]
     out = []
     for c, s in zip(cats, spots, strict=True):
         options = instances(CATEGORIES[int(c)])
         inst = options[int(rng.integers(len(options)))]
         rgb = np.clip(np.asarray(inst.rgba[:3]) + rng.uniform(-1, 1, 3) * COLOUR_JITTER, 0, 1)
-        x, y = DECOR_SPOTS[int(s)]
+        x, y = free[int(s)]
         out.append(
             {
                 "name": inst.name,

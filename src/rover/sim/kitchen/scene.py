@@ -71,8 +71,13 @@ class Scene:
         return out
 
 
-def draw_layout(rng: np.random.Generator, used: list[str]) -> dict[str, Placement | None]:
-    """Fixtures the task uses stand in reach (ranges of `FIXTURES`), the rest in far slots.
+def draw_layout(
+    rng: np.random.Generator,
+    used: list[str],
+    yaw_ranges: dict[str, tuple[float, float]] | None = None,
+) -> dict[str, Placement | None]:
+    """Fixtures the task uses stand in reach (ranges of `FIXTURES`; a task may narrow a
+    fixture's yaw range with `yaw_ranges`), the rest in far slots.
 
     Two used fixtures share the reach zone side by side: the first keeps its drawn y, the
     second is moved along the counter until their footprints are 5 cm apart.
@@ -87,9 +92,8 @@ def draw_layout(rng: np.random.Generator, used: list[str]) -> dict[str, Placemen
             if abs(y - ty) < gap:
                 y = ty + gap if y >= ty else ty - gap
         taken.append((y, fx.half_width))
-        layout[name] = Placement(
-            float(rng.uniform(*fx.x_range)), y, float(rng.uniform(*fx.yaw_range))
-        )
+        yaw = (yaw_ranges or {}).get(name, fx.yaw_range)
+        layout[name] = Placement(float(rng.uniform(*fx.x_range)), y, float(rng.uniform(*yaw)))
     others = [n for n in FIXTURES if n not in used]
     order = rng.permutation(len(others))
     free = [s for s in SLOTS if all(abs(s - ty) > tw + 0.25 for ty, tw in taken)]
@@ -102,9 +106,14 @@ def draw_layout(rng: np.random.Generator, used: list[str]) -> dict[str, Placemen
     return {n: layout[n] for n in FIXTURES}
 
 
-def draw_scene(rng: np.random.Generator, used: list[str], decor: list[dict]) -> Scene:
+def draw_scene(
+    rng: np.random.Generator,
+    used: list[str],
+    decor: list[dict],
+    yaw_ranges: dict[str, tuple[float, float]] | None = None,
+) -> Scene:
     """One kitchen: layout, a texture per surface, light and camera modder seeds."""
-    layout = draw_layout(rng, used)
+    layout = draw_layout(rng, used, yaw_ranges)
     return Scene(layout=layout, decor=decor, **draw_style(rng))
 
 

@@ -43,6 +43,9 @@ FOOD = ItemRole("food item", "food container", "beside fixture", "microwave")
 # rad the door swings to count as open (its range is 0-1.9): at 90% of it, 1.2 rad, the
 # level hand carrying the food passes it into the cavity
 DOOR_OPEN = 1.35
+# rad: the microwave's yaw, only turned clockwise (seen from above) of the fixture's
+# (-0.2, 0.2); at positive yaw 8 of 8 seeds failed (11m's and this session's runs)
+MICROWAVE_YAW = (-0.2, 0.0)
 DOOR_REACH_CLOSED = 0.92  # closed = at most 10% open: 92% of the way back from open
 
 
@@ -121,6 +124,11 @@ def microwave_thawing() -> TaskSpec:
             "fixture": "Microwave",
             "part": "door",
             "level_start": True,  # the forward grasp's level-hand ready pose
+            # turned the other way (yaw > 0), the door's swing folded the arm onto its
+            # pedestal while pulling it open, and the wrist hit its limit pressing start
+            "yaw_range": list(MICROWAVE_YAW),
+            # no décor on the hinge side: the hand goes round the open door's outside
+            "decor_clear": [-1.2, -0.2],
             "items": [[FOOD.name, FOOD.category, FOOD.start, FOOD.goal]],
             "parts": parts(),
         },
