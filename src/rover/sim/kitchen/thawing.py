@@ -44,7 +44,7 @@ FOOD = ItemRole("food item", "food container", "beside fixture", "microwave")
 # level hand carrying the food passes it into the cavity
 DOOR_OPEN = 1.35
 # rad: the microwave's yaw, only turned clockwise (seen from above) of the fixture's
-# (-0.2, 0.2); at positive yaw 8 of 8 seeds failed (11m's and this session's runs)
+# (-0.2, 0.2): in session 7's 20-seed baseline all 8 positive-yaw scenes failed
 MICROWAVE_YAW = (-0.2, 0.0)
 DOOR_REACH_CLOSED = 0.92  # closed = at most 10% open: 92% of the way back from open
 
