@@ -1,8 +1,10 @@
 """Kitchen composite MicrowaveThawing: two worked parts of one fixture (door, button).
 
-The spec comes from `rover.sim.kitchen.thawing.microwave_thawing` (built, not registered
-until its expert meets the target). The MuJoCo tests check that the door's and the
-button's facts, predicates, goals and joint fractions each come from their own joint."""
+The spec comes from `rover.sim.kitchen.thawing.microwave_thawing` (registered as
+kitchen.MicrowaveThawing). The MuJoCo tests check that the door's and the button's facts,
+predicates, goals and joint fractions each come from their own joint, that the scene is
+drawn from the task's own part of the microwave's ranges, and that the chained expert
+does the four components in order and leaves the door shut."""
 
 from __future__ import annotations
 
@@ -161,3 +163,45 @@ def test_door_and_button_facts_predicates_and_goals_come_from_their_own_joints(s
     assert sim.point("joint:microwave door closed")[0] == pytest.approx(1.0)
     # after the working() switches, the env's joint is the first part's again
     assert env.part == DOOR and env.kind == "door" and env.target == pytest.approx(DOOR_OPEN)
+
+
+@pytest.mark.sim
+def test_scene_draws_the_microwave_from_the_tasks_own_ranges(sim):
+    from rover.sim.kitchen.thawing import MICROWAVE_X, MICROWAVE_Y, MICROWAVE_YAW
+
+    seen = []
+    for seed in range(4):
+        sim.reset(seed)
+        place = sim.env.scene.layout["Microwave"]
+        assert MICROWAVE_X[0] <= place.x <= MICROWAVE_X[1]
+        assert MICROWAVE_Y[0] <= place.y <= MICROWAVE_Y[1]
+        assert MICROWAVE_YAW[0] <= place.yaw <= MICROWAVE_YAW[1]
+        assert all(d["y"] > -0.2 for d in sim.env.scene.decor)  # none on the hinge side
+        seen.append((place.x, place.y, place.yaw))
+    assert len(set(seen)) == 4  # still drawn per seed
+
+
+@pytest.mark.sim
+@pytest.mark.slow
+def test_chained_expert_thaws_in_order_and_leaves_the_door_shut(sim):
+    from rover.sim.experts import run_expert
+    from rover.sim.facts import detect_events, facts_for_states
+
+    demo = run_expert(sim, 0)  # seed 0 once hit a décor pot's handle picking the food
+    assert demo.success and len(demo.subtask_ends) == 6
+    assert demo.subtask_ends == sorted(demo.subtask_ends)
+    picks = np.linspace(0, len(demo.states) - 1, 60).round().astype(int)
+    facts = facts_for_states(sim, demo.states[picks], demo.states[np.maximum(picks - 1, 0)])
+    last = facts[-1]
+    assert last.objects[FOOD].inside == "microwave"
+    assert last.articulations[DOOR] <= 0.1  # shut again, not pulled ajar leaving it
+    assert last.pressed == ["button"] or last.articulations["button"] >= 0.9
+    ev = {(e.name, e.object): e.frame for e in detect_events(sim.spec, facts)}
+    order = [
+        ev[("open_finish", DOOR)],
+        ev[("place", FOOD)],
+        ev[("close_finish", DOOR)],
+        ev[("press", "button")],
+    ]
+    assert None not in order and order == sorted(order), order
+    assert ev[("drop", FOOD)] is None

@@ -58,11 +58,13 @@ def test_every_built_paper_task_matches_its_table_row():
 
 def test_plan_names_missing_tasks_or_writes_the_available_ones():
     registered = task_names("all")
-    missing = [t for t in paper_task_names() if t not in registered]
-    if missing:
-        with pytest.raises(InputError) as err:
-            paper_plan(registered)
-        assert missing[0] in str(err.value) and "--available-only" in str(err.value)
+    assert all(t in registered for t in paper_task_names())  # all 27 are registered
+    tasks, counts, _ = paper_plan(registered)
+    assert len(tasks) == 27 and sum(map(sum, counts.values())) == 547
+    without = [t for t in registered if t != "kitchen.MicrowaveThawing"]
+    with pytest.raises(InputError) as err:
+        paper_plan(without)
+    assert "kitchen.MicrowaveThawing" in str(err.value) and "--available-only" in str(err.value)
     have = ["kitchen.OpenDrawer", "kitchen.TurnOffMicrowave"]
     tasks, counts, note = paper_plan(have, available_only=True)
     assert tasks == ["kitchen.OpenDrawer", "kitchen.TurnOffMicrowave"]
@@ -89,7 +91,6 @@ def test_level_counts_schedule_each_level_as_table_5_says():
 @pytest.mark.parametrize(
     ("args", "said"),
     [
-        (["--preset", "paper"], "do not exist yet"),
         (["--preset", "paper", "--tasks", "Lift"], "--preset paper sets --tasks"),
         (["--preset", "paper", "--per-level", "2"], "--per-level"),
         (["--preset", "papers"], "--preset must be 'paper'"),
@@ -97,8 +98,6 @@ def test_level_counts_schedule_each_level_as_table_5_says():
     ],
 )
 def test_generate_preset_refuses_up_front(tmp_path, args, said):
-    if said == "do not exist yet" and all(t in task_names("all") for t in paper_task_names()):
-        pytest.skip("all 27 paper tasks exist")
     out = tmp_path / "ds"
     res = CliRunner().invoke(app, ["generate", *args, "--out", str(out)])
     assert res.exit_code != 0
@@ -140,3 +139,8 @@ def test_preset_sets_tasks_counts_views_and_size(tmp_path, monkeypatch):
     )
     assert isinstance(res.exception, _Captured), res.output
     assert seen["cfg"].views == ["wrist", "left"] and seen["cfg"].size == 128
+    # with all 27 tasks registered the preset needs no --available-only
+    res = CliRunner().invoke(app, ["generate", "--preset", "paper", "-o", str(tmp_path / "ds3")])
+    assert isinstance(res.exception, _Captured), res.output
+    assert seen["cfg"].tasks == paper_task_names()
+    assert len(work_items(seen["cfg"])) == 547

@@ -31,7 +31,7 @@ from rover.sim.kitchen.fixtures import COUNTER_TOP, FIXTURES
 from rover.sim.kitchen.forward_items import instance_named
 from rover.sim.kitchen.forward_items import item_instances as instances  # (forward table first)
 from rover.sim.kitchen.items import ItemGeoms, build_item, mass_inertia
-from rover.sim.kitchen.objects import COLOUR_JITTER, half_height
+from rover.sim.kitchen.objects import CATALOGUE, COLOUR_JITTER, Instance, half_height
 from rover.sim.kitchen.pan import PAN_REGION, build_pan_item, pan_mass_inertia, site_positions
 from rover.sim.kitchen.placement import item_bottom
 from rover.sim.kitchen.regions import locate, to_local
@@ -69,23 +69,36 @@ def own_inertial_frame(obj, mass: float, inertia) -> None:
     )
 
 
-DECOR_GAP = 0.2  # m: décor stands at least this far beyond an item's reach
+DECOR_GAP = 0.2  # m: décor stands at least this far beyond an item's reach and its own
+# m robosuite's `PotWithHandlesObject` handles stick out beyond its body (handle_length
+# 0.09 and radius 0.01, its defaults, which `build_object` keeps)
+POT_HANDLE_REACH = 0.1
+
+
+def decor_reach(inst: Instance) -> float:
+    """How far a décor piece reaches from its centre (m): a pot with its two handles."""
+    if inst.shape == "pan":
+        return inst.size[0] + POT_HANDLE_REACH
+    return float(max(inst.size[:2]))
 
 
 def clear_decor(decor: list[dict], objects: list[dict]) -> list[dict]:
     """The scene's décor without the pieces standing where the task's items are handled:
     a décor pan's 9 cm handles reached 1 cm from PreSoakPan's pan handle and stopped the
-    fingers above it. An item's reach is its half extent (a pan with its handle)."""
+    fingers above it, and in MicrowaveThawing a décor pot's handle 13 cm from the food
+    stopped the hand picking it. An item's reach is its half extent (a pan with its
+    handle); the décor piece's own reach counts too (`decor_reach`)."""
     from rover.sim.kitchen.pan import handle_length
 
     kept = []
     for d in decor:
         near = False
+        own = decor_reach(next(i for i in CATALOGUE if i.name == d["name"]))
         for obj in objects:
             inst = instance_named(obj["name"])
             reach = handle_length(inst) / 2 if inst.category == "pan" else max(inst.size[:2])
             gap = float(np.hypot(d["x"] - obj["qpos"][0], d["y"] - obj["qpos"][1]))
-            near = near or gap < reach + DECOR_GAP
+            near = near or gap < reach + own + DECOR_GAP
         if not near:
             kept.append(d)
     return kept

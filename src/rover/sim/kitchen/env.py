@@ -27,7 +27,7 @@ from robosuite.utils.mjmod import CameraModder, LightingModder
 from rover.sim.fixtures.base import FixtureEnv, FixtureObject
 from rover.sim.fixtures.button import PRESS_Q
 from rover.sim.fixtures.drawer import OPEN_Q
-from rover.sim.kitchen.fixtures import COUNTER_SIZE, COUNTER_TOP, FIXTURES
+from rover.sim.kitchen.fixtures import COUNTER_SIZE, COUNTER_TOP, FIXTURES, narrow_fixture
 from rover.sim.kitchen.forward_grasp import READY_Q
 from rover.sim.kitchen.items import ItemGeoms, build_item, mass_inertia
 from rover.sim.kitchen.objects import CATALOGUE, build_object, draw_decor, half_height, make_static
@@ -82,10 +82,11 @@ class RoverKitchen(FixtureEnv):
         level_start: start the Panda in the level-hand ready pose of the forward grasp
             (`rover.sim.kitchen.forward_grasp.READY_Q`); None: when the item's start or
             goal region lies behind a fixture's opening.
-        yaw_range: the task's own range for the fixture's yaw (rad), inside the
-            fixture's (`Fixture.yaw_range`); None: the fixture's. MicrowaveThawing turns
-            the microwave only one way: turned the other, the opening door swings toward
-            the arm's base and folds the arm onto its pedestal.
+        x_range, y_range, yaw_range: the task's own ranges for the fixture's origin
+            (x m away from the robot, y m along the counter) and yaw (rad), inside the
+            fixture's (`narrow_fixture`); None: the fixture's. MicrowaveThawing draws
+            the microwave from where its expert can pull the door open
+            (`rover.sim.kitchen.thawing.MICROWAVE_X`, ...).
         decor_clear: a band of counter y (m) no décor stands in: the arm's path around
             the fixture (MicrowaveThawing's hand goes round the open door's outer side,
             where a cereal box on a décor spot blocked its wrist). None: every spot.
@@ -103,16 +104,17 @@ class RoverKitchen(FixtureEnv):
         start: str = "counter",
         goal: str = "counter",
         level_start: bool | None = None,
+        x_range: tuple[float, float] | list[float] | None = None,
+        y_range: tuple[float, float] | list[float] | None = None,
         yaw_range: tuple[float, float] | list[float] | None = None,
         decor_clear: tuple[float, float] | list[float] | None = None,
         **kwargs,
     ) -> None:
         if fixture not in FIXTURES or part not in FIXTURES[fixture].joints:
             raise ValueError(f"kitchen fixture {fixture!r} has no part {part!r}")
-        own = FIXTURES[fixture].yaw_range
-        if yaw_range is not None and not own[0] <= yaw_range[0] < yaw_range[1] <= own[1]:
-            raise ValueError(f"{fixture} yaw range {yaw_range} is not inside {own}")
-        self.yaw_ranges = {} if yaw_range is None else {fixture: tuple(yaw_range)}
+        ranges = {"x_range": x_range, "y_range": y_range, "yaw_range": yaw_range}
+        ranges = {k: v for k, v in ranges.items() if v is not None}
+        self.narrowed = {fixture: narrow_fixture(fixture, **ranges)} if ranges else {}
         self.decor_clear = None if decor_clear is None else tuple(decor_clear)
         self.fixture_name = fixture
         self.kind = part  # the fixture's own part name (the experts read this)
@@ -262,7 +264,7 @@ class RoverKitchen(FixtureEnv):
     def _reset_internal(self) -> None:
         ManipulationEnv._reset_internal(self)
         decor = draw_decor(self.rng, self.decor_clear)
-        self.scene = draw_scene(self.rng, self.used, decor, self.yaw_ranges)
+        self.scene = draw_scene(self.rng, self.used, decor, self.narrowed)
         if self.item is not None:
             self.scene.item = draw_item(self.rng, self)
         self.apply_scene(self.scene)

@@ -9,7 +9,7 @@ counter, where they are seen but not in the way.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -113,3 +113,30 @@ FIXTURES: dict[str, Fixture] = {
         ),
     )
 }
+
+
+def narrow_fixture(
+    name: str,
+    x_range: tuple[float, float] | list[float] | None = None,
+    y_range: tuple[float, float] | list[float] | None = None,
+    yaw_range: tuple[float, float] | list[float] | None = None,
+) -> Fixture:
+    """`FIXTURES[name]` with a task's own, narrower ranges for its origin's x, y and yaw.
+
+    A task whose expert cannot work every pose the fixture allows draws from a part of
+    it (MicrowaveThawing: `rover.sim.kitchen.thawing`). The draw takes as many random
+    numbers as before, so the rest of the scene (y, textures, lights) stays the seed's.
+    Raises ValueError for a range not inside the fixture's own.
+    """
+    fx = FIXTURES[name]
+    out = {}
+    wanted = (("x_range", x_range), ("y_range", y_range), ("yaw_range", yaw_range))
+    for field_name, want in wanted:
+        own = getattr(fx, field_name)
+        if want is None:
+            continue
+        lo, hi = (float(v) for v in want)
+        if not own[0] <= lo < hi <= own[1]:
+            raise ValueError(f"{name} {field_name[:-6]} range {[lo, hi]} is not inside {list(own)}")
+        out[field_name] = (lo, hi)
+    return replace(fx, **out)

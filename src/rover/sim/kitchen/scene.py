@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from rover.sim.kitchen.fixtures import FIXTURES, SLOTS
+from rover.sim.kitchen.fixtures import FIXTURES, SLOTS, Fixture
 
 # robosuite texture files per surface (cube textures for boxes, 2D for planes/walls)
 TEXTURES: dict[str, tuple[str, ...]] = {
@@ -74,10 +74,10 @@ class Scene:
 def draw_layout(
     rng: np.random.Generator,
     used: list[str],
-    yaw_ranges: dict[str, tuple[float, float]] | None = None,
+    narrowed: dict[str, Fixture] | None = None,
 ) -> dict[str, Placement | None]:
-    """Fixtures the task uses stand in reach (ranges of `FIXTURES`; a task may narrow a
-    fixture's yaw range with `yaw_ranges`), the rest in far slots.
+    """Fixtures the task uses stand in reach (ranges of `FIXTURES`, or of a task's
+    `narrowed` copy of a fixture: `narrow_fixture`), the rest in far slots.
 
     Two used fixtures share the reach zone side by side: the first keeps its drawn y, the
     second is moved along the counter until their footprints are 5 cm apart.
@@ -85,15 +85,16 @@ def draw_layout(
     layout: dict[str, Placement | None] = {}
     taken: list[tuple[float, float]] = []  # (y, half width) of fixtures in reach
     for name in used:
-        fx = FIXTURES[name]
+        fx = (narrowed or {}).get(name, FIXTURES[name])
         y = float(rng.uniform(*fx.y_range))
         for ty, tw in taken:
             gap = tw + fx.half_width + 0.05
             if abs(y - ty) < gap:
                 y = ty + gap if y >= ty else ty - gap
         taken.append((y, fx.half_width))
-        yaw = (yaw_ranges or {}).get(name, fx.yaw_range)
-        layout[name] = Placement(float(rng.uniform(*fx.x_range)), y, float(rng.uniform(*yaw)))
+        layout[name] = Placement(
+            float(rng.uniform(*fx.x_range)), y, float(rng.uniform(*fx.yaw_range))
+        )
     others = [n for n in FIXTURES if n not in used]
     order = rng.permutation(len(others))
     free = [s for s in SLOTS if all(abs(s - ty) > tw + 0.25 for ty, tw in taken)]
@@ -110,10 +111,10 @@ def draw_scene(
     rng: np.random.Generator,
     used: list[str],
     decor: list[dict],
-    yaw_ranges: dict[str, tuple[float, float]] | None = None,
+    narrowed: dict[str, Fixture] | None = None,
 ) -> Scene:
     """One kitchen: layout, a texture per surface, light and camera modder seeds."""
-    layout = draw_layout(rng, used, yaw_ranges)
+    layout = draw_layout(rng, used, narrowed)
     return Scene(layout=layout, decor=decor, **draw_style(rng))
 
 

@@ -17,6 +17,7 @@ from rover.sim.kitchen.composites import TASKS as COMPOSITE_TASKS
 from rover.sim.kitchen.forward_composites import TASKS as FORWARD_COMPOSITE_TASKS
 from rover.sim.kitchen.language import PARAPHRASES
 from rover.sim.kitchen.pick_place import TASKS as PICK_PLACE_TASKS
+from rover.sim.kitchen.thawing import microwave_thawing
 from rover.sim.levels import by_milestone
 from rover.sim.part_travel import BUTTON_TARGET, DRAWER_OPEN_Q, DRAWER_START_OPEN
 from rover.sim.tasks._common import (
@@ -349,3 +350,4 @@ TASKS = [t.model_copy(update={"levels": by_milestone(t.levels, t.milestones)}) f
 TASKS += PICK_PLACE_TASKS  # the pick-and-place group (rover.sim.kitchen.pick_place)
 TASKS += COMPOSITE_TASKS  # the composite groups (rover.sim.kitchen.composites)
 TASKS += FORWARD_COMPOSITE_TASKS  # composites into openings (kitchen.forward_composites)
+TASKS += [microwave_thawing()]  # two parts of one fixture (rover.sim.kitchen.thawing)
