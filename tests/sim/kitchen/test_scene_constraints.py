@@ -59,12 +59,13 @@ def test_decor_clear_band_leaves_those_spots_empty() -> None:
 def test_a_decor_pots_handles_count_in_its_clearance() -> None:
     """Seed 0 of MicrowaveThawing: a steel pot 33 cm from the food, its handle 13 cm
     from it, stopped the hand picking the food; a small piece as far off stays."""
-    from rover.sim.kitchen.composite_env import POT_HANDLE_REACH, clear_decor, decor_reach
+    from rover.sim.kitchen.composite_env import POT_HANDLE_REACH, clear_decor, decor_overhang
     from rover.sim.kitchen.objects import CATALOGUE
 
     pot = next(i for i in CATALOGUE if i.name == "steel pan")
     jar = next(i for i in CATALOGUE if i.name == "spice jar")
-    assert decor_reach(pot) == pytest.approx(pot.size[0] + POT_HANDLE_REACH)
+    assert decor_overhang(pot) == pytest.approx(pot.size[0] + POT_HANDLE_REACH)
+    assert decor_overhang(jar) == 0.0  # the gap was set for the small pieces
     food = [{"name": "noodle cup", "qpos": [-0.054, 0.202, 0.84, 1.0, 0.0, 0.0, 0.0]}]
     decor = [
         {"name": pot.name, "x": -0.28, "y": 0.45},

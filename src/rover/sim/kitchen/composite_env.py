@@ -69,31 +69,33 @@ def own_inertial_frame(obj, mass: float, inertia) -> None:
     )
 
 
-DECOR_GAP = 0.2  # m: décor stands at least this far beyond an item's reach and its own
+DECOR_GAP = 0.2  # m: a décor piece's centre stands at least this far beyond an item's reach
 # m robosuite's `PotWithHandlesObject` handles stick out beyond its body (handle_length
 # 0.09 and radius 0.01, its defaults, which `build_object` keeps)
 POT_HANDLE_REACH = 0.1
 
 
-def decor_reach(inst: Instance) -> float:
-    """How far a décor piece reaches from its centre (m): a pot with its two handles."""
-    if inst.shape == "pan":
-        return inst.size[0] + POT_HANDLE_REACH
-    return float(max(inst.size[:2]))
+def decor_overhang(inst: Instance) -> float:
+    """How far a décor piece reaches past what `DECOR_GAP` allows for (m).
+
+    The gap was set for the small pieces (at most 6 cm from their centre), so they add
+    nothing; a pot's body and two handles reach 17 cm and add all of it.
+    """
+    return inst.size[0] + POT_HANDLE_REACH if inst.shape == "pan" else 0.0
 
 
 def clear_decor(decor: list[dict], objects: list[dict]) -> list[dict]:
     """The scene's décor without the pieces standing where the task's items are handled:
     a décor pan's 9 cm handles reached 1 cm from PreSoakPan's pan handle and stopped the
     fingers above it, and in MicrowaveThawing a décor pot's handle 13 cm from the food
-    stopped the hand picking it. An item's reach is its half extent (a pan with its
-    handle); the décor piece's own reach counts too (`decor_reach`)."""
+    stopped the hand picking it (its centre was 33 cm off). An item's reach is its half
+    extent (a pan with its handle); a pot's own reach counts too (`decor_overhang`)."""
     from rover.sim.kitchen.pan import handle_length
 
     kept = []
     for d in decor:
         near = False
-        own = decor_reach(next(i for i in CATALOGUE if i.name == d["name"]))
+        own = decor_overhang(next(i for i in CATALOGUE if i.name == d["name"]))
         for obj in objects:
             inst = instance_named(obj["name"])
             reach = handle_length(inst) / 2 if inst.category == "pan" else max(inst.size[:2])
