@@ -125,16 +125,17 @@ def narrow_fixture(
 
     A task whose expert cannot work every pose the fixture allows draws from a part of
     it (MicrowaveThawing: `rover.sim.kitchen.thawing`). The draw takes as many random
-    numbers as before, so the rest of the scene (y, textures, lights) stays the seed's.
+    numbers as before, so the rest of the scene (textures, lights, the other fixtures)
+    stays the seed's.
     Raises ValueError for a range not inside the fixture's own.
     """
     fx = FIXTURES[name]
     out = {}
     wanted = (("x_range", x_range), ("y_range", y_range), ("yaw_range", yaw_range))
     for field_name, want in wanted:
-        own = getattr(fx, field_name)
         if want is None:
             continue
+        own = getattr(fx, field_name)
         lo, hi = (float(v) for v in want)
         if not own[0] <= lo < hi <= own[1]:
             raise ValueError(f"{name} {field_name[:-6]} range {[lo, hi]} is not inside {list(own)}")

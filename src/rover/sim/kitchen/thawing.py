@@ -44,13 +44,13 @@ FOOD = ItemRole("food item", "food container", "beside fixture", "microwave")
 # level hand carrying the food passes it into the cavity
 DOOR_OPEN = 1.35
 # Where the microwave stands: parts of the fixture's ranges (`narrow_fixture`), from
-# session 8's 20-seed traces. Turned counter-clockwise (yaw > 0, fixture range -0.2..0.2)
-# all 8 of 8 scenes failed: the opening door swings toward the arm's base and folds the
-# arm onto its pedestal, or the wrist hits its limit over the button. Nearer the robot
-# than x = 0.105 (range 0.07..0.12), or nearer the counter's middle than y = -0.07
-# (range -0.2..-0.02), the pull on the handle folds the elbow to its limit with link 6 on
-# the pedestal and stalls (x < 0.085 5 of 5 failed; at 0.095..0.12 with y up to -0.07,
-# 19 of 20 passed, the one failure at x 0.100; at 0.105..0.12, 20 of 20).
+# the 20-seed traces of sessions 7 (yaw) and 8 (x, y). Turned counter-clockwise (yaw > 0,
+# fixture range -0.2..0.2) all 8 of 8 scenes failed: the opening door swings toward the
+# arm's base and folds the arm onto its pedestal, or the wrist hits its limit over the
+# button. Nearer the robot than x = 0.105 (range 0.07..0.12), or nearer the counter's
+# middle than y = -0.07 (range -0.2..-0.02), the pull on the handle folds the elbow to its
+# limit with link 6 on the pedestal and stalls (x < 0.085: 5 of 5 failed; at 0.095..0.12
+# with y up to -0.07, 19 of 20 passed, the one failure at x 0.100; at 0.105..0.12, 20/20).
 MICROWAVE_X = (0.105, 0.12)
 MICROWAVE_Y = (-0.18, -0.07)
 MICROWAVE_YAW = (-0.2, 0.0)
