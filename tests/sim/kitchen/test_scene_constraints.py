@@ -1,4 +1,5 @@
-"""A task's own narrowing of the scene draw: the fixture's x and yaw, and décor kept off a band.
+"""A task's own narrowing of the scene draw: the fixture's x, y and yaw, and décor kept off a
+band.
 
 MicrowaveThawing stands the microwave far out, turns it one way only and keeps décor off
 the hinge side (`rover.sim.kitchen.thawing`); the draw must honour all three on every
@@ -30,6 +31,13 @@ def test_task_ranges_narrow_the_fixture_draw() -> None:
     wide = [draw_layout(np.random.default_rng(s), ["Microwave"])["Microwave"] for s in range(40)]
     assert max(p.yaw for p in wide) > 0.0  # without the task's range the fixture's own applies
     assert min(p.x for p in wide) < 0.095
+    along = {"Microwave": narrow_fixture("Microwave", y_range=(-0.18, -0.07))}
+    ys = [
+        draw_layout(np.random.default_rng(s), ["Microwave"], along)["Microwave"].y
+        for s in range(40)
+    ]
+    assert all(-0.18 <= y <= -0.07 for y in ys) and max(ys) - min(ys) > 0.05
+    assert max(p.y for p in wide) > -0.07
 
 
 def test_narrowing_keeps_the_rest_of_the_scene() -> None:

@@ -31,7 +31,7 @@ from rover.sim.kitchen.fixtures import COUNTER_TOP, FIXTURES
 from rover.sim.kitchen.forward_items import instance_named
 from rover.sim.kitchen.forward_items import item_instances as instances  # (forward table first)
 from rover.sim.kitchen.items import ItemGeoms, build_item, mass_inertia
-from rover.sim.kitchen.objects import CATALOGUE, COLOUR_JITTER, Instance, half_height
+from rover.sim.kitchen.objects import COLOUR_JITTER, Instance, half_height
 from rover.sim.kitchen.pan import PAN_REGION, build_pan_item, pan_mass_inertia, site_positions
 from rover.sim.kitchen.placement import item_bottom
 from rover.sim.kitchen.regions import locate, to_local
@@ -95,7 +95,7 @@ def clear_decor(decor: list[dict], objects: list[dict]) -> list[dict]:
     kept = []
     for d in decor:
         near = False
-        own = decor_overhang(next(i for i in CATALOGUE if i.name == d["name"]))
+        own = decor_overhang(instance_named(d["name"]))
         for obj in objects:
             inst = instance_named(obj["name"])
             reach = handle_length(inst) / 2 if inst.category == "pan" else max(inst.size[:2])

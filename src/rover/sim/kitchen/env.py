@@ -112,9 +112,9 @@ class RoverKitchen(FixtureEnv):
     ) -> None:
         if fixture not in FIXTURES or part not in FIXTURES[fixture].joints:
             raise ValueError(f"kitchen fixture {fixture!r} has no part {part!r}")
-        ranges = {"x_range": x_range, "y_range": y_range, "yaw_range": yaw_range}
-        ranges = {k: v for k, v in ranges.items() if v is not None}
-        self.narrowed = {fixture: narrow_fixture(fixture, **ranges)} if ranges else {}
+        self.narrowed = {  # (without a task range, a copy equal to the fixture's own)
+            fixture: narrow_fixture(fixture, x_range=x_range, y_range=y_range, yaw_range=yaw_range)
+        }
         self.decor_clear = None if decor_clear is None else tuple(decor_clear)
         self.fixture_name = fixture
         self.kind = part  # the fixture's own part name (the experts read this)
